@@ -316,7 +316,8 @@ def test_unknown_behavior_in_use(tmp_path):
                  "behavior go:\n  use avoud when road is WIDE\nend\n")
     exc = error_of(lambda: load_rules_file(path), NameError_)
     assert exc.message == "unknown behavior `avoud`" and exc.hint == "did you mean `avoid`?"
-    assert str(exc.span) == f"{path}:6:3"
+    assert str(exc.span) == f"{path}:6:7"             # the name, not the whole `use` line
+    assert caret_under(exc) == "avoud"
 
 
 def test_unknown_behavior_in_load_rulebase():

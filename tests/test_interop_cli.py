@@ -579,6 +579,23 @@ def test_a_lesson_given_as_the_rule_base_points_to_lesson(capsys, monkeypatch) -
             "--lesson (`mitos teach [RULEBASE] --lesson rulebases/lessons/wider-turn.lesson`)") in err
 
 
+def test_a_lesson_by_name_given_as_the_rule_base_points_to_lesson(capsys, tmp_path: Path,
+                                                                   monkeypatch) -> None:
+    """`mitos teach wider-turn` (the packaged lesson, by the name `--lesson` takes) and
+    `mitos teach nothere.lesson` said "rule file not found" and pointed to `mitos list`'s
+    rule bases."""
+    monkeypatch.chdir(tmp_path)
+    for given, what in (("wider-turn", "a packaged lesson"),
+                        ("wider-turn.lesson", "a packaged lesson"),
+                        ("nothere.lesson", "a lesson")):
+        code, err = _run(capsys, "teach", given)
+        assert code == 1
+        assert err.splitlines()[-1] == (
+            f"hint: `{given}` is {what}, not a rule base: a lesson is run with --lesson "
+            f"(`mitos teach [RULEBASE] --lesson {given}`)")
+    assert not (tmp_path / ".mitos").exists()
+
+
 def test_a_rule_file_with_a_mistake_gets_no_format_hint(tmp_path: Path, capsys) -> None:
     rules = (ROOT / "rulebases" / "mitos.rules").read_text().replace("then steering", "thn steering", 1)
     (tmp_path / "m.rules").write_text(rules)

@@ -402,6 +402,11 @@ def test_save_as_names_a_rules_file(work):
                     stdin="")
         assert res.returncode == 2 and "is only the ending, give it a name" in res.stderr
         assert "does not end in" not in res.stderr
+    # an empty one is refused as every command's empty file name is (it said "ending in
+    # `.rules`, not ``")
+    res = mitos("teach", "rb/mitos.rules", "--save-as", "", "--lesson", "-", cwd=work, stdin="")
+    assert res.returncode == 2 and "must name something, not be empty" in res.stderr
+    assert "not ``" not in res.stderr
 
 
 def test_a_rule_file_lesson_or_world_that_is_a_link_to_nothing_is_said_so(work):
@@ -543,7 +548,7 @@ def test_a_packaged_lesson_is_shown_by_its_name_in_the_repository(work):
     (work / "w.lesson").write_text("use drve\n")
     res = mitos("teach", "--lesson", "w.lesson", cwd=work)
     assert res.returncode == 1 and res.stdout.startswith("w.lesson:1> use drve")
-    assert "w.lesson:1:1: name error: unknown behavior `drve`" in res.stderr
+    assert "w.lesson:1:5: name error: unknown behavior `drve`" in res.stderr
     res = mitos("teach", "--lesson", "wider-turn", cwd=work)
     assert res.returncode == 0, res.stderr
     assert res.stdout.startswith("rulebases/lessons/wider-turn.lesson:16> use drive\n")
@@ -591,3 +596,100 @@ def test_save_as_into_a_missing_path_is_refused_before_the_lesson_runs(work):
     assert "lesson error: cannot save `nope/deeper/x.rules`: the directory `nope` does not " \
            "exist" in res.stderr
     assert not (work / ".mitos").exists() and not (work / "nope").exists()
+
+
+def test_a_lesson_whose_save_as_cannot_be_written_at_its_end_says_how_to_go_on(work):
+    """The save a lesson makes at its end for `--save-as` (the place passed the checks before
+    the lesson; the write failed after it) was hinted `save ~/x.rules`, a command of the
+    prompt, with no session to give it in: the hint says how to continue the session."""
+    (work / "l.lesson").write_text("correct road=78 size=45 position=4 -> steering=60\n")
+    (work / "in").mkdir()
+    (work / "in" / "x.mitos.terms.yaml").mkdir()      # no file can be written where it goes
+    (work / "in" / "x.rules").write_text('terms "x.mitos.terms.yaml"\n')
+    res = mitos("teach", "rb/mitos.rules", "--lesson", "l.lesson", "--save-as", "in/x.rules",
+                cwd=work)
+    assert res.returncode == 1
+    session = next((work / ".mitos" / "teach").iterdir()).name
+    assert res.stderr.splitlines()[-1] == (
+        f"hint: every change is in the session's journal: `mitos teach --resume --session "
+        f"{session}`, then `save PATH` where you can write")
+
+
+def test_the_way_back_to_a_session_names_it_when_resume_alone_would_not_find_it(work):
+    """Leaving a session with unsaved changes said "`mitos teach --resume` (session A)
+    continues", also for a session that is not the newest here (`--resume` alone picks the
+    newest, B) and for one resumed from another directory (`--resume` alone looks in this
+    one's `.mitos/teach/`): the command given is the one that continues this session."""
+    mitos("teach", "rb/mitos.rules", cwd=work, stdin="if road is NARROW then speed is SLOW\n")
+    first = sorted((work / ".mitos" / "teach").iterdir())[0]
+    time.sleep(1.1)                                         # a second session, the newest
+    mitos("teach", "rb/mitos.rules", cwd=work, stdin="if road is WIDE then speed is SLOW\n")
+    res = mitos("teach", "--resume", "--session", first.name, cwd=work,
+                stdin="if road is MEDIUM then speed is SLOW\n")
+    assert res.returncode == 0, res.stderr
+    assert res.stderr.splitlines()[-1] == (
+        f"unsaved changes are kept in the journal; `mitos teach --resume --session "
+        f"{first.name}` continues, `save PATH` writes them")
+    elsewhere = work / "elsewhere"
+    elsewhere.mkdir()
+    res = mitos("teach", "--resume", "--session", str(first), cwd=elsewhere,
+                stdin="behavior b\nif road is WIDE then speed is FAST\n")
+    assert res.returncode == 0, res.stderr
+    assert res.stderr.splitlines()[-2:] == [
+        f"behavior `b` is still open; `mitos teach --resume --session {first.as_posix()}` "
+        f"keeps it open, `end` closes it",
+        f"unsaved changes are kept in the journal; `mitos teach --resume --session "
+        f"{first.as_posix()}` continues, `save PATH` writes them"]
+
+
+@pytest.mark.parametrize("encoding", ["utf-8", None])
+def test_the_prompt_reads_a_byte_that_is_not_utf8_as_a_mistake_of_its_line(work, encoding):
+    """Piped into the prompt, a byte that is not UTF-8 ended the session in a traceback
+    (`PYTHONIOENCODING=utf-8`: UnicodeDecodeError, the lines read with it lost), or was said
+    as `\\udce9W` with the caret beside it (the C locale's decoding); a byte-order mark at the
+    input's start made its first command "unexpected `\\ufeffif`". A lesson says the first as
+    "not UTF-8 text" and takes the second."""
+    env = dict(os.environ, COLUMNS="120")
+    env.pop("PYTHONIOENCODING", None)
+    if encoding:
+        env["PYTHONIOENCODING"] = encoding
+    stdin = (b"\xef\xbb\xbfif road is NARROW then speed is SLOW\r\n"
+             b"if road is NARR\xe9W then speed is SLOW\nshow history\n")
+    res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules"],
+                         cwd=work, input=stdin, capture_output=True, env=env, timeout=120)
+    out, err = res.stdout.decode(), res.stderr.decode()
+    assert res.returncode == 0, err
+    assert "Traceback" not in err and "\\udc" not in err and "\\ufeff" not in err
+    assert "r27: if road is NARROW then speed is SLOW" in out
+    assert "   2  if road is NARROW then speed is SLOW" in out        # `show history` ran
+    lines = err.splitlines()
+    at = lines.index("<prompt>:2:16: syntax error: the line is not UTF-8 text (byte 0xe9 at "
+                     "column 16)")
+    assert lines[at + 1:at + 3] == ["    if road is NARR\ufffdW then speed is SLOW",
+                                    "                   ^"]
+
+
+@pytest.mark.parametrize("encoding", ["utf-8", None])
+def test_a_lesson_on_stdin_is_read_as_a_lesson_file_is(work, encoding):
+    """`--lesson -` read stdin as text: a byte that is not UTF-8 was a UnicodeDecodeError
+    traceback (`PYTHONIOENCODING=utf-8`) or "unexpected `\\udce9W`", and a byte-order mark
+    "unexpected `\\ufeffif`", where the same lesson in a file is "not UTF-8 text" at its byte,
+    or read."""
+    env = dict(os.environ, COLUMNS="120")
+    env.pop("PYTHONIOENCODING", None)
+    if encoding:
+        env["PYTHONIOENCODING"] = encoding
+
+    def lesson(data):
+        res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rb/mitos.rules",
+                              "--lesson", "-"], cwd=work, input=data, capture_output=True,
+                             env=env, timeout=120)
+        return res.returncode, res.stdout.decode(), res.stderr.decode()
+
+    code, out, err = lesson(b"\xef\xbb\xbfif road is NARROW then speed is SLOW\r\n")
+    assert code == 0, err
+    assert "r27: if road is NARROW then speed is SLOW" in out
+    code, out, err = lesson(b"use drive\nif road is NARR\xe9W then speed is SLOW\n")
+    assert code == 1 and "Traceback" not in err and out == ""
+    assert err.splitlines()[-1] == ("<stdin>:2:16: lesson error: cannot read lesson `<stdin>`: "
+                                    "it is not UTF-8 text (byte 0xe9 at line 2, column 16)")

@@ -24,6 +24,9 @@ from mitos_cli.teach.commands import incomplete, parse_command
                (c.Assign("steering", 60), c.Assign("speed", 20)))),
     ("simulate worlds/figure4.yaml", c.Simulate("worlds/figure4.yaml")),
     ('simulate "my world.yaml" seed 3', c.Simulate("my world.yaml", "3")),
+    # a world's robots may be named as no bare word can be (`name: "cart 2"`, `name: "7"`)
+    ('simulate two.yaml robot "cart 2"', c.Simulate("two.yaml", None, "cart 2")),
+    ('simulate seven.yaml seed 1 robot "7"', c.Simulate("seven.yaml", "1", "7")),
     ("at 12.5s steering=55", c.At(12.5, None, (c.Assign("steering", 55),))),
     ("at 11 to 13s steering=55 speed=10",
      c.At(11, 13, (c.Assign("steering", 55), c.Assign("speed", 10)))),
@@ -95,8 +98,25 @@ def test_rule_lines_are_rules_of_the_rule_language():
     ("simulate figure4 seed 2x", "unexpected `x`", None, "a seed is a whole number"),
     ("simulate figure4 seed x", "unexpected `x`", "a seed", "a seed is a whole number"),
     ("simulate my world.yaml", "unexpected `world`", "`robot` or `seed`", "is quoted"),
+    # a mistyped option after the world's name was taken for a name with a space in it
+    ("simulate figure4 sed 3", "unexpected `sed`", "`robot` or `seed`", "did you mean `seed`?"),
+    ("simulate multirobot robt oncoming", "unexpected `robt`", "`robot` or `seed`",
+     "did you mean `robot`?"),
     ("simulate figure4 seed 3 robo x", "unexpected `robo`", "`robot`",
      "did you mean `robot`?"),
+    # the end of a `simulate` line after `seed` or `robot` said "name a world file"
+    ("simulate figure4 seed", "the line ends too early", "a seed",
+     "`simulate figure4 seed 42`"),
+    ("simulate multirobot robot", "the line ends too early", "a name",
+     "name the robot whose run `at` corrects, as the world names it"),
+    # a robot's name that is no plain word, and the options in the other order
+    ("simulate two.yaml robot cart 2", "unexpected `2`", "the end of the line",
+     'quoted: `robot "cart 2"`'),
+    # (a world's path holding the word `robot` is not where the robot's name begins)
+    ("simulate robots/two.yaml robot cart 2", "unexpected `2`", "the end of the line",
+     'quoted: `robot "cart 2"`'),
+    ("simulate multirobot robot oncoming seed 2", "unexpected `seed`", "the end of the line",
+     "the seed comes before the robot: `simulate multirobot seed 2 robot oncoming`"),
     # a relative instruction where a target goes: it needs a window of the recorded run
     ("correct heading=-5 -> turn harder", "unexpected `harder`", "`is`",
      "`turn harder` is an instruction: it takes a window of the recorded run, "

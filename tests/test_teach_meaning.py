@@ -315,6 +315,16 @@ def test_unknown_instruction_says_did_you_mean_and_lists_them():
     assert "`turn harder`" in info.value.expected and "`keep right`" in info.value.expected
 
 
+def test_two_instructions_joined_by_and_are_said_one_per_line():
+    """`at 12s to 13s make a wider turn and slow down` offered only `make a wider turn`, as if
+    the rest were a typo: each instruction is its own `at` line."""
+    with pytest.raises(LessonError) as info:
+        instruction(("make", "a", "wider", "turn", "and", "slow", "down"))
+    assert info.value.message == "unknown instruction `make a wider turn and slow down`"
+    assert info.value.hint == ("one instruction per `at` line: `at ... make a wider turn`, "
+                               "then `at ... slow down` (same window)")
+
+
 def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
 
@@ -400,6 +410,31 @@ def test_simulation_corrections_name_the_robot():
     assert s.state.examples[-1].inputs != first               # the other robot's perception
     with pytest.raises(LessonError, match="did you mean `oncoming`"):
         s.run("simulate multirobot robot oncomin")
+
+
+def test_a_robot_is_named_as_its_world_names_it(tmp_path, monkeypatch):
+    """A world's robot may be named with a space or in digits (`name: "cart 2"`, as `mitos
+    simulate` reads it): `robot NAME` takes it quoted, where it was a syntax error. An unknown
+    robot is marked at its own name: where the name was also a word before it (the world's
+    name), the caret stood under the world."""
+    from mitos_cli.teach.prompt import at_prompt
+    from mitos_cli.teach.session import Session
+    from mitos_cli.teach.simulation import world_path
+
+    monkeypatch.chdir(tmp_path)
+    text = world_path("multirobot").read_text()
+    (tmp_path / "two.yaml").write_text(text.replace("name: oncoming", 'name: "cart 2"'))
+    said = []
+    s = Session(default_rulebase_path(), out=said.append)
+    s.run("use drive")
+    s.run('simulate two.yaml robot "cart 2"')
+    assert "two (robot cart 2) with behavior drive" in said[-1]
+    line = "simulate multirobot seed 3 robot multirobot"
+    with pytest.raises(LessonError) as info:
+        s.run(line, "<prompt>", 4)
+    assert at_prompt(info.value, line, 4).render().splitlines()[:3] == [
+        "<prompt>:4:34: command error: unknown robot `multirobot` of `multirobot`",
+        "    " + line, " " * 37 + "^" * 10]
 
 
 def test_a_robot_that_stopped_is_corrected_only_up_to_its_stop():

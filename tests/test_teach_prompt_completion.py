@@ -60,3 +60,26 @@ def test_inputs_before_the_arrow(completer):
     assert "->" not in completer.words("eval road=78 ")
     # `st<tab>` gives `steering=` at once (a word form is typed: `steering is ...`)
     assert set(completer.words("correct road=78 -> ")) == {"steering=", "speed="}
+
+
+def test_simulate_completes_worlds_its_options_and_the_worlds_robots(completer):
+    """After `simulate` the prompt offered the rule language's words (`road`, `is`, `then`),
+    none of which can follow it; after `robot` too, where the world's robots go."""
+    assert set(completer.words("simulate ")) >= {"figure4", "multirobot", "corridor"}
+    assert set(completer.words("simulate fig")) >= {"figure4"}
+    assert set(completer.words("simulate figure4 ")) == {"seed", "robot"}
+    assert completer.words("simulate figure4 seed ") == []              # a number goes here
+    assert completer.words("simulate figure4 seed 3 ") == ["robot"]
+    assert set(completer.words("simulate multirobot robot ")) == {"robot", "oncoming"}
+    assert set(completer.words("simulate multirobot seed 2 robot onc")) == {"robot", "oncoming"}
+    assert completer.words("simulate nowhere.yaml robot ") == []     # no world: nothing
+
+
+def test_commands_complete_only_what_may_follow_them(completer):
+    """`save`, `undo`, `end` and `quit` were offered the rule language's words; `adapt` lacked
+    `unconstrained`; `unfrozen` (and `frozen`) take terms as `heading.AHEAD`."""
+    for line in ("save ", "undo ", "end ", "quit ", "exit "):
+        assert completer.words(line) == [], line
+    assert set(completer.words("adapt ")) == {"epochs", "rate", "plot", "unconstrained"}
+    assert {"heading.AHEAD", "steering.ST"} <= set(completer.words("unfrozen "))
+    assert {"heading.AHEAD", "r4"} <= set(completer.words("frozen "))

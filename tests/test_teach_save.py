@@ -3,6 +3,7 @@
 import json
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -513,6 +514,61 @@ def test_save_names_the_rule_file_it_could_not_write_and_the_directory_it_made(
     s.run(f"save {tmp_path / 'nodir' / 'x.rules'}")
     assert out[0] == f"created the directory {tmp_path / 'nodir'}"
     assert out[1].startswith(f"saved {tmp_path / 'nodir' / 'x.rules'}")
+
+
+def test_a_lesson_whose_save_cannot_be_written_is_not_told_to_save_where_it_may_not(
+        rules, tmp_path, monkeypatch):
+    """A lesson's `save` into a directory it cannot write was answered "save where you can
+    write files (`save ~/x.rules`)", which a lesson refuses (it writes below the working
+    directory only): the hint names what a lesson can do."""
+    import os
+
+    monkeypatch.chdir(tmp_path)
+    s = Session(rules, out=[].append)
+    s.run("correct road=78 size=45 position=4 -> steering=60")
+    (tmp_path / "locked").mkdir()
+    real_open = os.open
+
+    def refuse(path, *args, **kwargs):
+        if "locked" in str(path):
+            raise OSError(30, "Read-only file system")
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(os, "open", refuse)
+    s.confined = tmp_path                                   # as `run_lesson` sets it
+    with pytest.raises(LessonError) as info:
+        s.run("save locked/x.rules", "l.lesson", 2)
+    assert info.value.message == ("cannot save `locked/x.rules`: cannot write "
+                                  "`locked/x.mitos.terms.yaml`: Read-only file system")
+    assert "~/" not in info.value.hint
+    assert info.value.hint == ("a lesson saves below the working directory: save where you "
+                               "can write there, or give the place with `--save-as PATH`; "
+                               "the session keeps every change")
+
+
+def test_a_save_into_a_directory_it_cannot_write_is_refused_by_the_checks(rules, tmp_path,
+                                                                          monkeypatch):
+    """`--save-as ro/x.rules` (a read-only or foreign directory) ran the whole lesson and
+    failed at its end: the directory is asked for with the other checks, before a session
+    starts (`check_save_target`), also for a last directory the save would make in it."""
+    import os
+
+    from mitos_cli.teach.save import check_save_target
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode, **kw: False if Path(path) == locked
+                        else real_access(path, mode, **kw))
+    original = load_rules_file(rules)
+    for target in (locked / "x.rules", locked / "new" / "x.rules"):
+        with pytest.raises(LessonError) as info:
+            check_save_target(original, target)
+        assert info.value.message.startswith(f"cannot save `{target}`: cannot write in "
+                                             f"`{locked}`: ")
+        assert info.value.hint is None            # (the caller says where else to save)
+    assert not (locked / "new").exists()
+    check_save_target(original, tmp_path / "x.rules")        # the others are as before
 
 
 def _two_termsets_named_alike(tmp_path):

@@ -37,6 +37,70 @@ def say(s, out, line):
     return "\n".join(out)
 
 
+def test_a_wrapped_rule_is_one_line_of_the_history_and_of_undo(rules):
+    """A rule told over several lines was listed by `show history` (and said by `undo`) as
+    typed: its next lines at the left margin, outside the numbered list."""
+    s, out = session(rules)
+    s.run("if road is NARROW\n   and size is SMALL_SZ\n   then speed is SLOW")
+    assert say(s, out, "show history").splitlines()[1] == \
+        "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW"
+    assert say(s, out, "undo") == "undone: if road is NARROW and size is SMALL_SZ then speed is SLOW"
+    assert say(s, out, "show history").splitlines()[1:] == [
+        "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW  (undone)", "   3  undo"]
+
+
+def test_advice_to_use_a_behavior_while_one_is_open_closes_it_first(rules):
+    """While a behavior is open, `use NAME` is one of its lines (a blend), not a recall: the
+    notes that said "`use b1` before `adapt`" led to "`b1` uses `b1`: a cycle" (b1 open again
+    after `undo` of its `end`), or blended `drive` into the open behavior without a word."""
+    s, out = session(rules)
+    for line in ("behavior b1", "use drive", "end", "simulate figure4", "undo"):
+        s.run(line)                                         # `undo`: b1 is open again
+    text = say(s, out, "at 3s steering=50")
+    assert "; `end` (it then becomes the active behavior) before `adapt`" in text
+    with pytest.raises(LessonError) as info:
+        s.run("adapt epochs 1")
+    assert info.value.hint == ("the examples given so far correct b1: `end` (it then becomes "
+                               "the active behavior) to adapt it")
+    s.run("end")
+    s.run("behavior b2")
+    text = say(s, out, "simulate figure4")                  # b1 drives; the world's own: drive
+    assert text.endswith("(`mitos simulate` drives figure4 with behavior drive: `end` (`use` "
+                         "in the open behavior `b2` blends `drive` into it), then `use drive` "
+                         "to drive it so here)")
+
+
+def test_an_unknown_behavior_is_marked_at_its_name(rules):
+    """`use driv` was marked from `use` to the end of the line, where every other unknown
+    name (a term, a variable, a world, a label) is marked at itself."""
+    from mitos_cli.teach.prompt import at_prompt
+
+    s, _ = session(rules)
+    for line, caret in (("use driv", "    ^^^^"), ("behavior b", None),
+                        ("use drve when road is WIDE", "    ^^^^")):
+        if caret is None:
+            s.run(line)
+            continue
+        with pytest.raises(NameError_) as info:
+            s.run(line, "<prompt>", 3)
+        rendered = at_prompt(info.value, line, 3).render().splitlines()
+        assert rendered[0].startswith("<prompt>:3:5: name error: unknown behavior `dr")
+        assert rendered[2] == "    " + caret
+
+
+def test_a_label_another_behavior_has_adds_a_rule_here_and_says_so(rules):
+    """`r25: if ...` with `drive` active added a rule r25 to drive without a word, where the
+    instructor most likely meant to replace avoid_obstacle's r25 (the paper's rule)."""
+    s, out = session(rules)
+    s.run("use drive")
+    assert say(s, out, "r25: if road is NARROW then speed is SLOW").splitlines() == [
+        "r25: if road is NARROW then speed is SLOW", "  added to drive (1 rule)",
+        "  note: avoid_obstacle has a rule r25 too, which stays as it was (`use "
+        "avoid_obstacle` to replace that one)"]
+    assert "note" not in say(s, out, "r25: if road is WIDE then speed is SLOW")   # replaced
+    assert "note" not in say(s, out, "r77: if road is WIDE then speed is FAST")
+
+
 def test_a_told_rule_is_answered_as_understood_with_conflicts(rules):
     s, out = session(rules)
     text = say(s, out, "if road is  WIDE and size is SMALL_SZ and position is LEFT "
@@ -341,6 +405,8 @@ def test_every_command_of_the_table_has_help():
     for word in COMMAND_WORDS:
         assert help_text(word)
     assert "operators: and = product" in SUMMARY
+    # every option of `simulate` and `adapt` (`robot NAME` and `unconstrained` were left out)
+    assert "[seed N] [robot NAME]" in SUMMARY and "[plot FILE] [unconstrained]" in SUMMARY
 
 
 def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
@@ -400,6 +466,17 @@ def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     assert at_prompt(info.value, "show terms plot t.txt", 3).render().splitlines()[:3] == [
         "<prompt>:3:17: command error: cannot write `t.txt`: unknown picture format `txt`",
         "    show terms plot t.txt", "                    ^^^^^"]
+    # a plot into a directory that is not there is refused at its name, before the table
+    # (it printed every term, then "cannot write `nodir/t-road.png`" under the command word)
+    out.clear()
+    line = f"show terms plot {tmp_path / 'nodir' / 't.png'}"
+    with pytest.raises(MitosError) as info:
+        s.run(line, "<prompt>", 4)
+    assert out == []
+    assert at_prompt(info.value, line, 4).render().splitlines()[:3] == [
+        f"<prompt>:4:17: command error: cannot write `{tmp_path / 'nodir' / 't.png'}`: No "
+        f"such file or directory", "    " + line,
+        " " * 20 + "^" * len(str(tmp_path / "nodir" / "t.png"))]
 
 
 def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):
@@ -424,6 +501,11 @@ def test_a_hedge_or_time_that_cannot_be_used_is_refused_at_its_own_word(rules):
     assert place("at 5s to 2s steering is LB") == (4, 4, 12)
     assert place("at 5s to 2s steering=50") == (4, 4, 12)
     assert place("at 5s to 5.01s steering is very seldom LB") == (4, 33, 39)
+    # an instruction this run cannot take is marked at the instruction (it stood at column 1)
+    assert place("at 1s to 2s make a wider turn") == (4, 13, 30)           # it went straight
+    s.run("use avoid_obstacle")
+    s.run("simulate figure4")                               # no gap_left, gap_right here
+    assert place("at 0s to 2s keep further from the wall") == (4, 13, 39)
 
 
 def test_a_world_driven_with_another_behavior_than_its_own_says_so(rules):
@@ -743,6 +825,31 @@ def test_a_resumed_session_says_when_the_run_driven_again_is_another(tmp_path, m
                        "since; `at` corrects the run driven now")
 
 
+def test_a_world_simulated_by_a_relative_path_is_driven_again_from_another_directory(
+        tmp_path, monkeypatch):
+    """`simulate corridor.yaml` (a copy of the packaged world, its seed changed) was journaled
+    as `corridor.yaml`, relative: `--resume --session DIR` from another directory drove the
+    packaged `corridor` instead (another run, the warning blaming the world file), or a file
+    of that name there. The world's path is kept absolute, as `save`'s is."""
+    from mitos_cli.teach.simulation import world_path
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    monkeypatch.chdir(here)
+    text = world_path("corridor").read_text()
+    (here / "corridor.yaml").write_text(text.replace("seed: 1\n", "seed: 77\n", 1))
+    s = Session(default_rulebase_path(), journal=Journal.create(here / "j"), out=[].append)
+    s.run("use drive")
+    s.run("simulate corridor.yaml")
+    assert s.journal.entries[-1]["world"] == str(here / "corridor.yaml")
+    monkeypatch.chdir(elsewhere)
+    said: list[str] = []
+    again = Session.resume(Journal.open(here / "j"), out=said.append)
+    assert len(said) == 1 and said[0].startswith("the last run is recorded again")
+    assert again.simulation.fingerprint == s.simulation.fingerprint
+
+
 @pytest.mark.parametrize("line, message, column", [
     ("frozen road.NARROWW", "unknown term `NARROWW` of `road`", 13),
     ("frozen roadd.NARROW", "unknown variable `roadd`", 8),
@@ -812,6 +919,11 @@ def test_frozen_or_unfrozen_that_changes_nothing_is_no_unsaved_change(rules):
     say(s, out, "undo")                                 # takes back the AHEAD freeze only
     assert say(s, out, "undo") == "undone: frozen heading.LEFT"
     assert not s.unsaved
+    # several at once are "them" ("keeps steering.LM, road.MEDIUM as they are (`unfrozen`
+    # lets it move ...)")
+    assert say(s, out, "frozen steering.LM, road.MEDIUM") == (
+        "adaptation keeps steering.LM, road.MEDIUM as they are (`unfrozen` lets them move; "
+        "`save` writes `frozen: true`)")
 
 
 def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rules):

@@ -13,6 +13,7 @@ from .params import WORDS, named
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from ..lang.model import RuleBase
     from ..teach.session import Session
 
 
@@ -58,7 +59,7 @@ def teach_command(
         help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
              "the first error (exit 1).")] = None,
     save_as: Annotated[str | None, typer.Option(
-        "--save-as", "-o", metavar="OUT.rules",
+        "--save-as", "-o", metavar="OUT.rules", callback=named,
         help="Where `save` writes: OUT.rules and its term set beside it, OUT.terms.yaml (a "
              "rule file with several term sets, as the packaged one: OUT.<each term set's "
              "name>, e.g. OUT.mitos.terms.yaml and OUT.drive.terms.yaml); a lesson saves there "
@@ -136,9 +137,7 @@ def _resumed(session_name: str | None, recover: bool, save_as: str | None,
         exc.kind = "session error"
         raise
     if save_as is not None:
-        from ..teach.save import check_save_target
-
-        check_save_target(session.original, Path(save_as))
+        _check_save_as(session.original, save_as)
         session.save_as = Path(save_as)
     err(f"resumed session {journal.directory.name}: {plural(len(journal.active()), 'change')}, "
         f"{plural(len(session.state.examples), 'example')}, behavior {session.state.active}"
@@ -181,7 +180,8 @@ def _new_session(rules: str | None, behavior: str | None, lesson: str | None, sa
         link = broken_link("rule file", path)       # a dangling link, a loop: as eval says it
         raise RuleBaseError(link or (f"`{path}` is a directory, not a rule file" if path.is_dir()
                                      else f"rule file `{path}` not found"),
-                            hint=None if path.is_dir() or link else rule_file_not_found_hint(path))
+                            hint=None if path.is_dir() or link else
+                            (rules and _a_lesson(rules)) or rule_file_not_found_hint(path))
     try:
         loaded = load_rulebase(path, behavior)
     except MitosError as exc:           # a .fis, .fcl or .fll (by its name or not): convert it
@@ -196,15 +196,40 @@ def _new_session(rules: str | None, behavior: str | None, lesson: str | None, sa
                         "prompt (`simulate WORLD`)")
         raise
     if save_as is not None:         # refused now, not when the lesson ends and saves
-        from ..teach.save import check_save_target
-
-        check_save_target(loaded.rulebase, Path(save_as))
+        _check_save_as(loaded.rulebase, save_as)
     lesson_text = read_lesson(lesson) if lesson is not None else None
     journal = Journal.create(new_session_dir(path.stem))
     session = Session(path, behavior, journal, save_as, out=out, progress=epoch_progress)
     err(f"session {journal.directory.name} (journal in {journal.directory.as_posix()}; "
         f"`mitos teach --resume` continues it)")
     return session, lesson_text
+
+
+def _a_lesson(given: str) -> str | None:
+    """Where a lesson goes, for one named where the rule base goes that is not there: a
+    packaged lesson by the name `--lesson` takes (`mitos teach wider-turn`), or a `.lesson`
+    file (it said "rule file not found", and `mitos list` shows the packaged rule bases)."""
+    from ..resources import resolve
+
+    packaged = resolve("rulebases/lessons", given, ".lesson") is not None
+    if not packaged and not given.lower().endswith(".lesson"):
+        return None
+    return (f"`{given}` is {'a packaged lesson' if packaged else 'a lesson'}, not a rule base: "
+            f"a lesson is run with --lesson (`mitos teach [RULEBASE] --lesson {given}`)")
+
+
+def _check_save_as(rulebase: RuleBase, save_as: str) -> None:
+    """Refuse ``--save-as`` where a save cannot be made (a read-only directory, a term set there
+    that is not its own, ...) before a session starts, not once the lesson has run."""
+    from ..errors import LessonError
+    from ..teach.save import check_save_target
+
+    try:
+        check_save_target(rulebase, Path(save_as))
+    except LessonError as exc:
+        exc.hint = exc.hint or (f"give --save-as a place you can write (`--save-as "
+                                f"~/{Path(save_as).name}`)")
+        raise
 
 
 def _ended_open(session: Session, text: str, name: str) -> None:
@@ -217,7 +242,9 @@ def _ended_open(session: Session, text: str, name: str) -> None:
     from .output import err
 
     where = session.opened_at or lesson_end(text, name)
-    resume = f"mitos teach --resume --session {session.journal.directory.name}"
+    from ..teach.journal import resume_command
+
+    resume = resume_command(session.journal.directory)
     if session.save_as is not None:
         raise LessonError(f"the lesson ended with behavior `{session.state.block}` still open, "
                           f"so it cannot be saved to {session.save_as}", span=where,
@@ -251,14 +278,25 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
             err(f"session {directory.name} removed: the lesson stopped before any change")
         raise
     except KeyboardInterrupt:
-        err(f"interrupted: every change so far is in the journal; `mitos teach --resume "
-            f"--session {directory.name}` continues")
+        from ..teach.journal import resume_command
+
+        err(f"interrupted: every change so far is in the journal; `{resume_command(directory)}` "
+            f"continues")
         raise typer.Exit(130) from None
     if session.state.block is not None:
         _ended_open(session, text, name)
     if session.save_as is not None and session.unsaved:
         if transcript is not None:
             transcript.command("save (the lesson ended with unsaved changes)")
-        session.run("save")
+        try:
+            session.run("save")
+        except MitosError as exc:   # no prompt to `save ~/...` at: how to go on
+            if exc.message.startswith(("cannot save", "cannot create")):
+                from ..teach.journal import resume_command
+
+                exc.hint = (f"every change is in the session's journal: "
+                            f"`{resume_command(directory)}`, then `save PATH` where you can "
+                            f"write")
+            raise
     if transcript is not None:
         emit(transcript.to_json(directory, session))

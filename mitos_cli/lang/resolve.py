@@ -281,7 +281,8 @@ def _check_behavior(b: Behavior, variables: dict[str, Variable], behaviors: list
         check_rule(rule, variables)
     for use in b.uses:
         if use.behavior not in behaviors:
-            raise unknown("behavior", use.behavior, behaviors, span=use.span)
+            raise unknown("behavior", use.behavior, behaviors,
+                          span=use.span and use.span.naming(use.behavior))
         if use.condition is not None:
             check_expr(use.condition, variables)
         _check_weight(use.weight, use.weight_span or use.span)

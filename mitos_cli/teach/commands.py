@@ -180,6 +180,7 @@ class Simulate:
     world: str
     seed: str | None = None          # as written: checked to be digits by the session
     robot: str | None = None         # which robot's run `at` corrects (default: the first)
+    robot_span: Span | None = field(default=None, compare=False)     # where its name is written
 
 
 @dataclass(frozen=True)
@@ -304,9 +305,14 @@ class _ToCommand(_ToModel):
         token = items[0]    # quoted as a rule file's `terms` ("C:\Users\..." ended in a traceback)
         return _unquote(token) if token.type == "STRING" else str(token)
 
+    @v_args(meta=True)
+    def robot_name(self, meta: Meta, items: list[Token]) -> tuple[str, Span | None]:
+        token = items[0]
+        return (_unquote(token) if token.type == "STRING" else str(token)), self._s(meta)
+
     def simulate_cmd(self, items: list[Any]) -> Simulate:             # (world, seed or None, robot or None)
-        return Simulate(items[0], None if items[1] is None else str(items[1]),
-                        None if items[2] is None else str(items[2]))
+        robot, where = items[2] if items[2] is not None else (None, None)
+        return Simulate(items[0], None if items[1] is None else str(items[1]), robot, where)
 
     @v_args(meta=True)
     def time(self, meta: Meta, items: list[float]) -> tuple[float, Span | None]:
@@ -641,6 +647,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
         if text.split()[:1] == ["at"] and "to" in text.split()[2:3]:   # LALR's merged states:
             expected = {e for e in expected if e.upper() != "TO"}     # the `to` is behind us
+        if text.split()[:1] == ["simulate"] and text.split()[-1] == "robot":
+            expected = {"NAME"}             # (a quoted one is said by the hint)
         return RuleSyntaxError("the line ends too early",
                                span=Span.in_text(text, path, line, column),
                                expected=_expected(expected), hint=_eof_hint(text))
@@ -655,6 +663,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     if before[:1] == ["adapt"] and before[-1:] not in (["epochs"], ["rate"], ["plot"]):
         # LALR's merged states: after `adapt epochs 50` it read "expected `,`, `->` or a name"
         expected = {"EPOCHS", "RATE", "PLOT", "UNCONSTRAINED", "$END"}
+    if before[:1] == ["simulate"] and before[-1:] == ["robot"]:
+        expected = {"NAME"}                 # (a quoted one is said by the hint)
     if before[:1] == ["simulate"]:          # LALR's merged states: no `adapt` option here
         expected -= {"EPOCHS", "RATE", "PLOT", "UNCONSTRAINED"}
         if "ROBOT" in expected and "seed" not in before:    # (`seed` is an anonymous token)
@@ -723,9 +733,17 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
                     "speed is SLOW`")
         return "values are separated by spaces, not commas: `road=78 size=45`"
     glued = at > 0 and not text[at - 1].isspace()
+    if before[:1] == ["simulate"] and "robot" in before:
+        return _robot_hint(text, token, before)
     if before[:1] == ["simulate"] and (before[-1:] == ["seed"]                  # `seed x`
                                        or before[-2:-1] == ["seed"] and glued):  # `seed 2x`
         return "a seed is a whole number written in digits (such as 42)"
+    if before[:1] == ["simulate"] and len(before) == 2:   # `sed 3`: an option, mistyped
+        from ..errors import did_you_mean
+
+        close = did_you_mean(str(token.value), ["seed", "robot"])
+        if close is not None:
+            return close
     if (before[:1] == ["save"] or before[:1] == ["simulate"] and len(before) == 2
             or before[-2:-1] == ["plot"]):                      # just after the file name
         return 'a file name with a space in it is quoted: "my file.rules"'
@@ -751,6 +769,23 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
     return _hedge_hint(text, token)                      # a rule's condition: any hedge
 
 
+def _robot_hint(text: str, token: Token, before: list[str]) -> str:
+    """After `simulate WORLD ... robot`: the seed said after the robot (the grammar takes it
+    before), or a robot's name that is no bare name (`cart 2`, `7`, `r-2.b`), which a world
+    may give (`name: "cart 2"`) and the line takes quoted."""
+    robot = before.index("robot")
+    if str(token.value) == "seed" and robot < len(before) - 1:
+        seed = text[token.end_pos:].split()[:1] or ["42"]
+        return ("the seed comes before the robot: `" + " ".join(
+            before[:robot] + ["seed", seed[0]] + before[robot:]) + "`")
+    said = list(re.finditer(r"(?<=\s)robot\s+", text[:token.start_pos or len(text)]))
+    name = text[said[-1].end():].strip() if said else ""    # (the keyword, not `robots/`)
+    name = name.split(" seed ")[0].strip() or "NAME"
+    quoted = name if name.startswith('"') else '"' + name.replace('"', '\\"') + '"'
+    return (f"a robot's name that is no bare name (a space, a dot, digits alone) is quoted: "
+            f"`robot {quoted}`")
+
+
 def _describe(token: Token) -> str:
     return "the end of the line" if token.type == "$END" else f"`{token.value}`"
 
@@ -766,6 +801,12 @@ def _eof_hint(text: str) -> str | None:
         return "write `at 12.5s OUTPUT=VALUE ...` (after `simulate WORLD`)"
     if first in ("eval",):
         return "give the inputs as NAME=VALUE, e.g. `eval road=78 size=45 position=4`"
+    if first == "simulate" and words[-1] == "seed" and len(words) > 2:
+        return f"a seed is a whole number written in digits: `{' '.join(words)} 42`"
+    if first == "simulate" and words[-1] == "robot" and len(words) > 2:
+        return ("name the robot whose run `at` corrects, as the world names it (its first is "
+                "`robot`): `simulate multirobot robot oncoming`, quoted when the name is no "
+                'bare name (`robot "cart 2"`)')
     if first == "simulate":
         return "name a world file, e.g. `simulate worlds/figure4.yaml`"
     if first == "unfrozen":

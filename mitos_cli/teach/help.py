@@ -13,12 +13,13 @@ Tell rules, correct outputs, let the robot adapt, save. Every change is journale
   use NAME                                       make NAME the active behavior
   eval road=78 size=45 position=4                the DOF trace of the active behavior
   correct road=78 size=45 position=4 -> steering=60 speed=20    an example of what you want
-  simulate worlds/figure4.yaml [seed N]          drive the active behavior through a world
+  simulate worlds/figure4.yaml [seed N] [robot NAME]    drive the active behavior through a world
   at 12.5s steering=55   |   at 11s to 13s steering is LM    corrections during that drive
   at 13s to 14.5s make a wider turn              ... or in words (`help at` lists them)
   frozen heading.AHEAD  |  unfrozen heading.AHEAD    keep a term as it is, or let it move
   operators: and = product                       operators of the open (or active) behavior
-  adapt [epochs N] [rate ETA] [plot FILE]        learn from the examples (Q never increases)
+  adapt [epochs N] [rate ETA] [plot FILE] [unconstrained]    learn from the examples (Q never
+                                                 increases; `unconstrained`: order and bounds only)
   show rules|terms|examples|behaviors|history [plot FILE]
   undo        take back the last change
   save [PATH] write the rule file and its term set (the original is kept unless named)
@@ -64,7 +65,8 @@ Outputs you leave out are not corrected.""",
     "simulate": """\
 simulate WORLD [seed N] [robot NAME]
 Drive the active behavior through a world file (a path, or the name of a packaged world) and
-keep the recorded run, so that `at` can correct it (robot NAME's run; default the first).""",
+keep the recorded run, so that `at` can correct it (robot NAME's run; default the first;
+a name that is no bare name is quoted, as `robot "cart 2"`).""",
     "at": """\
 at 12.5s steering=55          one example: what the robot perceived at 12.5 s, and the output
                               it should have chosen

@@ -224,6 +224,10 @@ def instruction(words: tuple[str, ...]) -> Instruction:
     if text in INSTRUCTIONS:
         return INSTRUCTIONS[text]
     close = did_you_mean(text, list(INSTRUCTIONS))
+    said = [part.strip() for part in f" {text} ".split(" and ")]
+    if len(said) > 1 and all(part in INSTRUCTIONS for part in said):   # `... turn and slow down`
+        close = ("one instruction per `at` line: " + ", then ".join(
+            f"`at ... {part}`" for part in said) + " (same window)")
     raise LessonError(f"unknown instruction `{text}`",
                       expected="one of " + ", ".join(f"`{k}`" for k in INSTRUCTIONS)
                       + ", or `OUTPUT is TERM`, or `OUTPUT=VALUE`",

@@ -40,6 +40,18 @@ def sessions_dir(base: Path | None = None) -> Path:
     return (base or Path.cwd()) / ROOT
 
 
+def resume_command(directory: Path) -> str:
+    """The command that continues the session in ``directory``: by its name where it lies
+    under this directory's `.mitos/teach/`, else by its path (`--resume` alone picks the
+    newest session here, which need not be this one)."""
+    try:
+        here = directory.parent.resolve() == sessions_dir().resolve()
+    except OSError:
+        here = False
+    return (f"mitos teach --resume --session "
+            f"{directory.name if here else directory.absolute().as_posix()}")
+
+
 def new_session_dir(stem: str, base: Path | None = None) -> Path:
     """A fresh directory ``.mitos/teach/<stem>-<date>-<time>[-n]``, the stem cut to
     :data:`STEM_CHARS` characters: a rule file of a 245-character name could not be taught

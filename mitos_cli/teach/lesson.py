@@ -145,14 +145,35 @@ def lesson_end(text: str, path: str) -> Span:
     return Span.in_text(text, path, len(lines), len(lines[-1]) + 1)
 
 
-def read_lesson(source: str) -> tuple[str, str]:
-    """The lesson text and the name to report (``-`` reads stdin)."""
+def _read_stdin() -> str:
+    """A lesson on stdin, read as a lesson file is (:func:`~mitos_cli.fileio.read_text`):
+    UTF-8, a byte-order mark skipped, a byte that is not UTF-8 said at its line and column (as
+    text it was a UnicodeDecodeError traceback, or a name holding `\\udce9`). No more than
+    the limit and a character is kept."""
     import sys
 
+    buffer = getattr(sys.stdin, "buffer", None)
+    if buffer is None:                  # (a text stream with no bytes under it; none, closed)
+        return sys.stdin.read(MAX_LESSON_CHARS + 1) if sys.stdin is not None else ""
+    limit = 4 * (MAX_LESSON_CHARS + 1)  # bytes that hold a character past the limit
+    data = buffer.read(limit)
+    if len(data) >= limit:              # past the limit whatever it holds: said by its size
+        return data.decode("utf-8-sig", errors="replace")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        from ..fileio import bad_byte, unreadable
+
+        raise LessonError(unreadable("lesson", "<stdin>", exc),
+                          span=bad_byte("<stdin>", exc)) from None
+
+
+def read_lesson(source: str) -> tuple[str, str]:
+    """The lesson text and the name to report (``-`` reads stdin)."""
     from ..resources import resolve
 
-    if source == "-":                       # no more than the limit and a character, kept
-        text = sys.stdin.read(MAX_LESSON_CHARS + 1)
+    if source == "-":
+        text = _read_stdin()
         check_lesson_size(text, "<stdin>")
         return text, "<stdin>"
     path = Path(source)

@@ -33,6 +33,7 @@ class Completer:
     def __init__(self, session: Session) -> None:
         self.session = session
         self.matches: list[str] = []
+        self._robots: dict[str, list[str]] = {}        # world -> its robots' names
 
     def words(self, line: str) -> list[str]:
         rb = self.session.rulebase
@@ -50,10 +51,17 @@ class Completer:
         if first == "use":
             return [b.name for b in rb.behaviors] + ["when", "with"]
         if first == "adapt":
-            return ["epochs", "rate", "plot"]
+            return ["epochs", "rate", "plot", "unconstrained"]
+        terms = [f"{v.name}.{t}" for v in rb.variables.values() for t in v.term_names]
         if first == "frozen":
             b = rb.behavior(self.session.focus)
-            return [r.label for r in b.rules if r.label]
+            return [r.label for r in b.rules if r.label] + terms
+        if first == "unfrozen":
+            return terms
+        if first == "simulate":
+            return self.simulate_words(line, tokens)
+        if first in ("save", "undo", "end", "quit", "exit"):
+            return []                   # (a file name, or nothing: no word of the language)
         if first in ("eval", "correct", "at"):
             inputs = [f"{v.name}=" for v in rb.variables.values() if v.role == "input"]
             outputs = [v.name for v in rb.variables.values() if v.role == "output"]
@@ -68,6 +76,39 @@ class Completer:
             terms = list(rb.variables[var].term_names) if var else []
             return terms + ["not", *HEDGES]
         return list(rb.variables) + ["is", "and", "or", "not", "then", "with"]
+
+    def simulate_words(self, line: str, tokens: list[str]) -> list[str]:
+        """After `simulate`: the packaged worlds, then `seed` and `robot`, and after `robot`
+        the robots of the world named (quoted where a name is no bare word)."""
+        back = tokens if line.endswith(" ") else tokens[:-1]
+        if len(back) == 1:
+            from ..resources import packaged_names
+
+            return [n.removesuffix(".yaml") for n in packaged_names("worlds", ".yaml")]
+        if back[-1] == "seed" or "robot" in back[:-1]:
+            return []                                   # a number, or the end of the line
+        if back[-1] == "robot":
+            return self.robots(back[1])
+        return (["seed"] if "seed" not in back else []) + ["robot"]
+
+    def robots(self, world: str) -> list[str]:
+        """The robots of ``world`` by their names, as `simulate ... robot` takes them."""
+        import re
+
+        from ..errors import MitosError
+        from .simulation import world_path
+
+        if world not in self._robots:
+            try:
+                from ..sim.worldfile import load_world
+
+                names = [a.name for a in load_world(world_path(world, self.session.base)).agents]
+            except (MitosError, OSError):
+                names = []
+            self._robots[world] = [n if re.fullmatch(r"[A-Za-z_][\w\-]*", n) and
+                                   not n.endswith("-") else '"' + n.replace('"', '\\"') + '"'
+                                   for n in names]
+        return self._robots[world]
 
     def target_words(self, line: str, tokens: list[str], outputs: list[str]) -> list[str]:
         """The words that go on a target (``correct ... ->`` or ``at TIME``): an output's
@@ -155,6 +196,32 @@ def at_prompt(exc: MitosError, line: str, lineno: int) -> MitosError:
     return exc
 
 
+def _undecoded(line: str, lineno: int) -> MitosError | None:
+    """A line holding a byte the input's encoding could not read (kept as a lone surrogate),
+    said as a lesson says it ("not UTF-8 text"), the byte shown as U+FFFD under the caret."""
+    from ..errors import RuleSyntaxError
+
+    at = next((i for i, c in enumerate(line) if "\udc80" <= c <= "\udcff"), None)
+    if at is None:
+        return None
+    try:                                # (a stderr that cannot write U+FFFD: `?`)
+        "\ufffd".encode(getattr(sys.stderr, "encoding", None) or "utf-8")
+        mark = "\ufffd"
+    except (UnicodeEncodeError, LookupError):
+        mark = "?"
+    shown = "".join(mark if "\udc80" <= c <= "\udcff" else c for c in line)
+    row = line.count("\n", 0, at) + 1
+    column = at - (line.rfind("\n", 0, at) + 1) + 1
+    byte = ord(line[at]) - 0xDC00
+    encoding = str(getattr(sys.stdin, "encoding", None) or "utf-8")
+    encoding = "UTF-8" if encoding.lower().replace("_", "-") in ("utf-8", "utf8") else encoding
+    return RuleSyntaxError(f"the line is not {encoding} text (byte 0x{byte:02x} at column "
+                           f"{column})",
+                           span=Span.in_text("\n" * (lineno - 1) + shown, PROMPT,
+                                             lineno + row - 1, column, column + 1),
+                           hint="names are written in ASCII letters, digits, `_` and `-`")
+
+
 def interact(session: Session, history: Path | None = None) -> None:
     """Read and run commands until ``quit`` or end of input.
 
@@ -165,6 +232,10 @@ def interact(session: Session, history: Path | None = None) -> None:
     readline = _setup_readline(session, history) if tty else None
     err = sys.stderr
     lines_read = 0
+    # a byte the input's encoding cannot read is the line's mistake, said at its place: read
+    # strictly (`PYTHONIOENCODING=utf-8`) it was a traceback, the lines read with it lost
+    with contextlib.suppress(AttributeError, ValueError, OSError):   # (not a text file)
+        sys.stdin.reconfigure(errors="surrogateescape")     # type: ignore[union-attr]
     session.out("MITOS teaching prompt: tell rules, correct, adapt, save. `help` lists the "
                 "commands; Ctrl-D or `quit` leaves (nothing is lost).")
     try:
@@ -190,7 +261,13 @@ def interact(session: Session, history: Path | None = None) -> None:
             except KeyboardInterrupt:
                 print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
                 continue
+            if lineno == 1:                      # a file piped in, written with a BOM
+                line = line.removeprefix("\ufeff")
             if not line.strip() or line.lstrip().startswith("#"):
+                continue
+            bad = _undecoded(line, lineno)
+            if bad is not None:
+                print(bad.render(), file=err)
                 continue
             try:                                 # Ctrl-C anywhere here keeps the session
                 if readline is not None and history is not None:
@@ -208,10 +285,12 @@ def interact(session: Session, history: Path | None = None) -> None:
                 session.out("")
                 break
     finally:
+        from .journal import resume_command
+
+        resume = resume_command(session.journal.directory)
         if session.state.block is not None:
-            print(f"behavior `{session.state.block}` is still open; `mitos teach --resume` "
-                  f"keeps it open, `end` closes it", file=err)
+            print(f"behavior `{session.state.block}` is still open; `{resume}` keeps it open, "
+                  f"`end` closes it", file=err)
         if session.unsaved:
-            where = session.journal.directory.name
-            print(f"unsaved changes are kept in the journal; `mitos teach --resume` "
-                  f"(session {where}) continues, `save PATH` writes them", file=err)
+            print(f"unsaved changes are kept in the journal; `{resume}` continues, `save PATH` "
+                  f"writes them", file=err)

@@ -152,16 +152,23 @@ def distinct_names(termset_paths: tuple[str, ...]) -> list[str]:
 
 
 def save_rulebase(original: RuleBase, current: RuleBase, target: Path,
-                  sources: Sources | None = None) -> Saved:
+                  sources: Sources | None = None, elsewhere: str | None = None) -> Saved:
     """Write ``current`` to ``target`` (and its term sets), as edits of the texts ``original``
-    was read from: ``sources``, else its files as they are now."""
+    was read from: ``sources``, else its files as they are now. A file that cannot be written
+    is an error whose hint is ``elsewhere`` (default: save at another place, `save ~/...`)."""
     if original.path is None:
         raise LessonError("this rule base has no file to save from")
     src = Path(original.path)
     if src.suffix.lower() in (".fcl", ".fis", ".fll"):
         raise LessonError(f"`{src.name}` is not in the rule language; saving keeps the rule "
                           f"language only", hint="save to a `.rules` file after converting it")
-    files, changes = saved_files(original, current, target, sources)
+    elsewhere = elsewhere or (f"save where you can write files (`save ~/{target.name}`); the "
+                              f"session keeps every change")
+    try:
+        files, changes = saved_files(original, current, target, sources)
+    except LessonError as exc:          # a place it cannot write, found before writing
+        exc.hint = exc.hint or elsewhere
+        raise
     created = _directory_for(target)
     try:
         finish_saves(target, error=LessonError)        # one a crash left half done
@@ -170,9 +177,7 @@ def save_rulebase(original: RuleBase, current: RuleBase, target: Path,
         if created is not None:
             with contextlib.suppress(OSError):
                 created.rmdir()                         # made for this save: nothing in it
-        raise LessonError(f"cannot save `{target}`: {exc.message}",
-                          hint=f"save where you can write files (`save ~/{target.name}`); "
-                               "the session keeps every change") from None
+        raise LessonError(f"cannot save `{target}`: {exc.message}", hint=elsewhere) from None
     return Saved(target, tuple(d for d, _ in files[:-1]), changes, created)
 
 
@@ -367,6 +372,7 @@ def _check_directory(target: Path) -> None:
     missing directory whose parent is missing too (only the last one is made)."""
     parent = target.parent
     if parent.is_dir():
+        _check_writable(target, parent)
         return
     for up in (parent, parent.parent):  # `save notes.txt/x.rules`: said "File exists"
         if up.exists() and not up.is_dir():
@@ -375,6 +381,20 @@ def _check_directory(target: Path) -> None:
     if not parent.parent.is_dir():
         raise LessonError(f"cannot save `{target}`: the directory `{parent.parent}` does not "
                           f"exist", hint="check the path, or create the directory first")
+    _check_writable(target, parent.parent)          # where the missing one would be made
+
+
+def _check_writable(target: Path, directory: Path) -> None:
+    """Refuse a save into a directory this process may not write (a read-only file system,
+    another user's directory): `--save-as ro/x.rules` ran the whole lesson, then failed."""
+    if os.access(directory, os.W_OK | os.X_OK):
+        return
+    try:
+        read_only = bool(os.statvfs(directory).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):   # (no statvfs: Windows)
+        read_only = False
+    raise LessonError(f"cannot save `{target}`: cannot write in `{directory}`: "
+                      f"{'Read-only file system' if read_only else 'Permission denied'}")
 
 
 def _directory_for(target: Path) -> Path | None:

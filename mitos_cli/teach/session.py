@@ -350,7 +350,8 @@ class Session:
             self.out(f"warning: the last run ({last.get('line', 'simulate')}) cannot be driven "
                      f"again: {exc.message}; `simulate` it again to correct it")
             return
-        self.out(f"the last run is recorded again: {self.simulation.describe()}")
+        self.out(f"the last run is recorded again: "
+                 f"{self.simulation.describe(self.use_advice)}")
         if last.get("run") not in (None, self.simulation.fingerprint):   # (older journals: none)
             self.out(f"warning: this is not the run recorded before ({last.get('verdict')}, "
                      f"now {self.simulation.verdict}): `{Path(last['world']).name}` or a file "
@@ -425,6 +426,11 @@ class Session:
         head = f"{format_rule(rule)}"
         if before is None:
             self.out(f"{head}\n  added to {b.name} ({plural(len(b.rules) + 1, 'rule')})")
+            elsewhere = [o.name for o in self.rulebase.behaviors if o.name != b.name
+                         and c.rule.label and rule.label in self._index(o).position]
+            if elsewhere:                   # (the one the instructor meant to replace?)
+                self.out(f"  note: {elsewhere[0]} has a rule {rule.label} too, which stays as "
+                         f"it was ({self.use_advice(elsewhere[0])} to replace that one)")
         else:
             self.out(f"{head}\n  replaces {format_rule(before)}")
         after = self.rulebase.behavior(b.name).rules
@@ -474,7 +480,8 @@ class Session:
         use = c.use
         names = [b.name for b in self.rulebase.behaviors]
         if use.behavior not in names:
-            raise unknown("behavior", use.behavior, names, span=use.span)
+            raise unknown("behavior", use.behavior, names,
+                          span=use.span and use.span.naming(use.behavior))
         if self.state.block is None:
             if use.condition is not None or use.weight != 1.0:
                 raise LessonError("`use B when C` blends behaviors and belongs inside a "
@@ -528,8 +535,8 @@ class Session:
                       if o.name != b.name and any(r.label == label for r in o.rules)]
             own = "" if labels else f"`{b.name}` has no rules of its own; "
             if owners:
-                exc.hint = (f"{own}`{label}` is a rule of `{owners[0]}`: `use {owners[0]}`, "
-                            f"then `frozen {label}`")
+                exc.hint = (f"{own}`{label}` is a rule of `{owners[0]}`: "
+                            f"{self.use_advice(owners[0])}, then `frozen {label}`")
             elif own:
                 exc.hint = own.rstrip("; ")
         return exc
@@ -552,8 +559,9 @@ class Session:
         if new:
             self.change("freeze", line, terms=new)
             self.out("adaptation keeps " + ", ".join(f"{v}.{t}" for v, t in new)
-                     + (" as it is" if len(new) == 1 else " as they are")
-                     + " (`unfrozen` lets it move; `save` writes `frozen: true`)")
+                     + (" as it is (`unfrozen` lets it move" if len(new) == 1 else
+                        " as they are (`unfrozen` lets them move")
+                     + "; `save` writes `frozen: true`)")
         if already:
             self.out(", ".join(already) + (" is" if len(already) == 1 else " are")
                      + " frozen already: adaptation keeps "
@@ -735,17 +743,33 @@ class Session:
         window = Window({o: np.array([y[o] for y in now]) for o in compiled.outputs},
                         {k: np.array([x[k] for x in inputs]) for k in compiled.inputs},
                         compiled.variables)
-        wanted = targets(ins, window)
+        try:                            # (what this run cannot take: at the instruction)
+            wanted = targets(ins, window)
+        except LessonError as exc:
+            exc.span = exc.span or c.span
+            raise
         keep = np.flatnonzero(np.isfinite(wanted))
         if keep.size == 0:
             raise LessonError(f"`{ins.words}`: the robot went straight {rec.when(rows)}, so "
-                              "there is no turn to change", hint="name the window of a turn")
+                              "there is no turn to change", span=c.span,
+                              hint="name the window of a turn")
         first = keep[0]
         did = float(window.outputs[ins.output][first])
         self.out(f"{ins.words}: {ins.meaning} ({ins.output} {text.num(did)} -> "
                  f"{text.num(float(wanted[first]))} at {rec.time(rows[first]):g} s)")
         self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
                          [{ins.output: float(wanted[i])} for i in keep], line)
+
+    def use_advice(self, name: str) -> str:
+        """How to make behavior ``name`` the active one now: `use NAME`, but while a behavior
+        is open a `use` line is one of its lines (a blend), so it is closed first."""
+        block = self.state.block
+        if block is None:
+            return f"`use {name}`"
+        if block == name:
+            return "`end` (it then becomes the active behavior)"
+        return (f"`end` (`use` in the open behavior `{block}` blends `{name}` into it), then "
+                f"`use {name}`")
 
     def _recording(self) -> Recording:
         if self.simulation is None:
@@ -774,9 +798,9 @@ class Session:
             self._noted = (id(rec), self.state.active)      # once per run and active behavior
             self.out(f"note: {rec.name} was driven by `{rec.behavior}`, so this corrects "
                      f"{rec.behavior} (the rules that produced the motion, with the behaviors "
-                     f"it uses), not the active `{self.state.active}`; `use {rec.behavior}` "
-                     f"before `adapt` (to teach `{self.state.active}` from a run, `simulate` "
-                     "with it active)")
+                     f"it uses), not the active `{self.state.active}`; "
+                     f"{self.use_advice(rec.behavior)} before `adapt` (to teach "
+                     f"`{self.state.active}` from a run, `simulate` with it active)")
         return self.compiled(rec.behavior)
 
     def _outputs(self, compiled: CompiledRuleBase, inputs: list[dict]) -> list[dict]:
@@ -792,11 +816,14 @@ class Session:
         seed = _seed(c.seed) if c.seed is not None else None
         self.compiled()
         self.simulation = run_world(c.world, self.rulebase, self.state.active, seed, self.base,
-                                    c.robot)
-        self.journal.append("simulate", line=line, world=str(world_path(c.world, self.base)),
+                                    c.robot, c.robot_span)
+        # the path as it names the world from anywhere (`--resume --session DIR` elsewhere
+        # drove the packaged world of a relative path's name, or a file of that name there)
+        self.journal.append("simulate", line=line,
+                            world=os.path.abspath(world_path(c.world, self.base)),
                             behavior=self.state.active, seed=seed, robot=c.robot,
                             run=self.simulation.fingerprint, verdict=self.simulation.verdict)
-        self.out(self.simulation.describe())
+        self.out(self.simulation.describe(self.use_advice))
 
     def _at(self, c: cmd.At, line: str) -> None:
         rec = self._recording()
@@ -834,8 +861,8 @@ class Session:
             example = ("correct road=78 size=45 position=4 -> steering=60"
                        if tuple(compiled.inputs) == ("road", "size", "position") else
                        f"correct {shown} -> {compiled.outputs[0]}=...")
-            hint = (f"the examples given so far correct {', '.join(others)}: `use "
-                    f"{others[0]}` to adapt it" if others else
+            hint = (f"the examples given so far correct {', '.join(others)}: "
+                    f"{self.use_advice(others[0])} to adapt it" if others else
                     f"give corrections: `{example}` (every input of `{compiled.behavior}`), "
                     f"or `simulate WORLD` then `at 12.5s {compiled.outputs[0]}=55`")
             raise LessonError(f"no examples for behavior `{compiled.behavior}` to learn from",
@@ -954,10 +981,12 @@ class Session:
         elif c.what == "terms":
             if c.plot is not None:      # the name given, not the first one made from it
                 from ..draw.output import check_format
+                from ..fileio import check_writable
 
-                with _drawing():
+                with _drawing():        # (and before the table, which said it all first)
                     check_format(c.plot)
-                _check_below(c.plot, self.confined, "terms.png")
+                    _check_below(c.plot, self.confined, "terms.png")
+                    check_writable(c.plot)
             self.out(text.terms_table(self.original, self.rulebase, self._shownvariables()))
             if c.plot is not None:
                 self._plot_terms(self.original, self.rulebase, c.plot)
@@ -982,7 +1011,7 @@ class Session:
         last = active[-1]
         self.journal.append("undo", of=last["seq"], line=line)
         self.replay(checked=False)
-        self.out(f"undone: {last.get('line') or last['op']}")
+        self.out(f"undone: {text.one_line(last.get('line') or '') or last['op']}")
 
     def _save(self, c: cmd.Save, line: str) -> None:
         from .save import save_rulebase
@@ -1016,7 +1045,8 @@ class Session:
             # a Ctrl-C once the files are written waits for what the session knows of them:
             # the next save over them was refused as if another program had changed them
             with held_interrupt():
-                saved = save_rulebase(self.original, self.rulebase, target, self.sources)
+                saved = save_rulebase(self.original, self.rulebase, target, self.sources,
+                                      LESSON_SAVE_HINT if self.confined is not None else None)
                 if over:
                     self.files_seen = files_digest(self.original)
                 written = (saved.rules,) + saved.termsets
@@ -1194,6 +1224,13 @@ def _is_dir(path: Path) -> bool:
         return path.is_dir()
     except OSError:
         return False
+
+
+#: where a lesson's `save` that could not be written may go instead (not `~/`: a lesson
+#: writes below the working directory only, :func:`_check_below`)
+LESSON_SAVE_HINT = ("a lesson saves below the working directory: save where you can write "
+                    "there, or give the place with `--save-as PATH`; the session keeps every "
+                    "change")
 
 
 def _check_below(written: str, root: Path | None, example: str = "taught.rules") -> None:

@@ -20,6 +20,8 @@ from ..lang.model import RuleBase
 from ..words import clearance, plural
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from ..sim.loop import SimResult
 
 
@@ -90,7 +92,9 @@ class Recording:
             s = {**s, **self.result.robot_metrics[self.robot]}
         return f"{s['outcome']} after {s['time_s']:g} s"
 
-    def describe(self) -> str:
+    def describe(self, use: Callable[[str], str] | None = None) -> str:
+        """The run's verdict, and where to go on; ``use(NAME)`` says how to make a behavior
+        the active one (default `` `use NAME` ``)."""
         s = self.result.summary()
         if self.robot_name:              # the corrected robot's own run, not the world's
             own = self.result.robot_metrics[self.robot]
@@ -100,9 +104,9 @@ class Recording:
         return (f"{self.name}{who} with behavior {self.behavior}: {s['outcome']} after "
                 f"{s['time_s']:g} s (min clearance {clearance(s['min_clearance_in'])} in, "
                 f"{plural(s['collisions'], 'collision')}); "
-                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)" + self._whose())
+                f"correct it with `at TIME OUTPUT=VALUE` (0 to {self.end:g} s)" + self._whose(use))
 
-    def _whose(self) -> str:
+    def _whose(self, use: Callable[[str], str] | None = None) -> str:
         """A note when the session drove the world with another behavior than the one
         ``mitos simulate`` drives it with (the file's first behavior is rarely a driver: a new
         session's `avoid_obstacle` hits Figure 4's first obstacle after 2 s)."""
@@ -113,7 +117,7 @@ class Recording:
             return (f"\n  ({self.name}'s world file names behavior `{own}`, which this rule "
                     "base does not have)")
         return (f"\n  (`mitos simulate` drives {self.name} with behavior {own}: "
-                f"`use {own}` to drive it so here)")
+                f"{use(own) if use is not None else f'`use {own}`'} to drive it so here)")
 
     def rows(self, start: float, stop: float | None,
              places: tuple[Span | None, Span | None] = (None, None)) -> np.ndarray:
@@ -159,9 +163,10 @@ class Recording:
 
 
 def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = None,
-              base: Path | None = None, robot: str | None = None) -> Recording:
+              base: Path | None = None, robot: str | None = None,
+              robot_span: Span | None = None) -> Recording:
     """Drive ``behavior`` of ``rulebase`` through the world ``name``; ``at`` then corrects
-    ``robot`` (a name of the world's robots; default the first)."""
+    ``robot`` (a name of the world's robots, written at ``robot_span``; default the first)."""
     from ..sim.loop import simulate
     from ..sim.planner import FuzzyPlanner
     from ..sim.worldfile import load_world
@@ -172,7 +177,8 @@ def run_world(name: str, rulebase: RuleBase, behavior: str, seed: int | None = N
     if robot is not None and robot not in names:
         from ..errors import unknown
 
-        raise unknown(f"robot of {Path(name).name}", robot, names, cls=LessonError)
+        raise unknown("robot", robot, names, span=robot_span, cls=LessonError,
+                      owner=Path(name).stem)
     index = names.index(robot) if robot is not None else 0
     try:
         planner = FuzzyPlanner(rulebase, behavior)

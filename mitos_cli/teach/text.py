@@ -123,6 +123,12 @@ def behaviors_text(rb: RuleBase, active: str, open_block: str | None) -> str:
     return "\n".join(lines) + "\n(* active: `use NAME` recalls another)"
 
 
+def one_line(command: str) -> str:
+    """A command as one line: a rule told over several lines joined by single spaces (its
+    next lines stood at the left margin of the history's numbered list)."""
+    return " ".join(part.strip() for part in command.splitlines() if part.strip())
+
+
 def history_text(entries: list[dict]) -> str:
     undone = {e["of"] for e in entries if e["op"] == "undo"}
     lines = []
@@ -130,7 +136,7 @@ def history_text(entries: list[dict]) -> str:
         if e["op"] == "start":
             lines.append(f"{e['seq']:>4}  started on {e['rules']} ({e['behavior']})")
             continue
-        text = e.get("line") or e["op"]
+        text = one_line(e.get("line") or "") or e["op"]
         if e["op"] == "adapt":
             stopped = e.get("stopped")
             ran = e.get("ran")
