@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from ..errors import InputError
-from ..words import clearance
 from .output import _matplotlib, finish, new_figure
 
 if TYPE_CHECKING:
@@ -169,7 +168,7 @@ def draw_run(result: SimResult, path: str | Path | None = None, *, footprint_eve
     ax.set_ylabel("y (in)")
     m = result.metrics
     ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
-                 f"(seed {result.seed}, min clearance {clearance(m['min_clearance_in'])} in)",
+                 f"(seed {result.seed}, min clearance {result.shown_clearance()} in)",
                  fontsize=9)
     return finish(fig, path, show)
 

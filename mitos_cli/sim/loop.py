@@ -204,7 +204,14 @@ class SimResult:
                 f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({plural(self.ticks, 'tick')}"
                 f"{f', {robots} robots' if robots > 1 else ''}), path "
                 f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
-                f"{shown_clearance(m.get('min_clearance_in', 0.0))} in>")
+                f"{self.shown_clearance()} in>")
+
+    def shown_clearance(self) -> str:
+        """The run's least clearance as the verdict of ``mitos simulate`` prints it: to a
+        tenth, with as many more digits as it takes to show which side of the robots' least
+        safety margin it lies on (1.99 beside 2 is ``1.99``, not ``2.0``)."""
+        margin = min((a.robot.safety_margin for a in self.world.agents), default=None)
+        return shown_clearance(self.metrics.get("min_clearance_in", 0.0), margin)
 
     def _repr_png_(self) -> bytes | None:
         """A notebook shows the run as ``--plot`` draws it (nothing without matplotlib)."""
