@@ -856,6 +856,16 @@ def test_a_corridor_in_metres_gets_a_hint_about_units():
     assert "lies inside a wall" in text and "lengths in a world are inches" in text
 
 
+@pytest.mark.parametrize("width", ["0.3", "0.001"])
+def test_the_units_hint_offers_no_metres_that_are_still_too_narrow(width):
+    """`width: 0.3` said "if 0.3 is metres, write 12", a corridor still narrower than the
+    18 in robot, and `width: 0.001` "write 0", which the reader refuses."""
+    text = error(BASE.replace("width: 70", f"width: {width}"))
+    assert (f"hint: lengths in a world are inches: a corridor `width: {width}` is narrower "
+            "than the robot (18 in wide)\n") in text + "\n"
+    assert "is metres" not in text
+
+
 OBSTACLES = ("obstacles:\n"
              "  - {name: buried, shape: circle, at: [150, 80], radius: 5}\n"
              "  - {name: slab, shape: rectangle, at: [250, -60], length: 20, width: 10}\n"
