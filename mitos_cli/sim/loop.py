@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from ..errors import CommandError, InputError, WorldError
+from ..numbers import whole_number
 from ..words import clearance as shown_clearance
 from ..words import plural
 from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors
@@ -178,7 +179,16 @@ class SimResult:
     _true: dict | None = field(default=None, repr=False)
 
     def route_at(self, k: int, i: int) -> Route:
-        """The route robot ``i`` followed at tick ``k`` (its last replan up to then)."""
+        """The route robot ``i`` followed at tick ``k`` (its last replan up to then); a tick or
+        a robot the run does not have is an :class:`InputError` (a tick past the end gave the
+        last route without a word, and a robot past the last an ``IndexError``)."""
+        robots = len(self.routes)
+        if (j := whole_number(i)) is None or not 0 <= j < robots:
+            raise InputError(f"i is the index of one of the run's {plural(robots, 'robot')}, "
+                             f"0 to {robots - 1}, not `{i!r:.40}`")
+        if (tick := whole_number(k)) is None or not 0 <= tick < self.ticks:
+            raise InputError(f"k is a tick of the run, 0 to {self.ticks - 1}, not `{k!r:.40}`")
+        k, i = tick, j
         route = self.routes[i]
         for tick, j, r in self.replanned:
             if j == i and tick <= k:
