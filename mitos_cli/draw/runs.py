@@ -13,7 +13,9 @@ import numpy as np
 from .output import _matplotlib, finish
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.text import Annotation
 
     from ..sim.loop import Scene
     from ..sim.world import World
@@ -32,7 +34,7 @@ def draw_runs(overlay: RunsOverlay, world: World, scene: Scene, path: str | Path
     from matplotlib.patches import Circle, Polygon
 
     from ..sim.geometry import rect_corners
-    from .world import inward, map_axes, place_legend
+    from .world import map_axes, place_legend
 
     fig, ax = map_axes(scene.static, show=show, extra_width=0.4)
     for route in scene.routes:
@@ -60,12 +62,7 @@ def draw_runs(overlay: RunsOverlay, world: World, scene: Scene, path: str | Path
     for n, c in enumerate(overlay.collisions):
         ax.plot(c.x, c.y, marker="x", ms=7, mew=1.6, color="black", zorder=5,
                 label="collision" if n == 0 else None)
-    for x, y, count, first, last in overlay.collision_places():
-        when = f"{first:.1f} s" if count == 1 else f"{count}×, {first:.1f}-{last:.1f} s"
-        # on the side facing the middle: a collision near a wall keeps its label in the map
-        ax.annotate(when, (x, y), fontsize=7, zorder=6, **inward(ax, x, y),
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                          "alpha": 0.8})
+    _label_collisions(ax, overlay.collision_places())
     for agent in world.agents:
         ax.plot(agent.start.x, agent.start.y, marker="o", color="#2f6b2f", ms=5, zorder=4)
         ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
@@ -78,3 +75,36 @@ def draw_runs(overlay: RunsOverlay, world: World, scene: Scene, path: str | Path
     ax.set_title(f"{overlay.world}: {len(seeds)} runs (seeds {seeds[0]}..{seeds[-1]}), "
                  "paths by the run's outcome", fontsize=9)
     return finish(fig, path, show)
+
+
+def _label_collisions(ax: Axes, places: list[tuple[float, float, int, float, float]]) -> None:
+    """A label per place (``12×, 14.5-14.9 s``), on the side facing the middle (a collision
+    near a wall keeps its label in the map); a place whose label would overlap one drawn
+    already is counted in that one. The places are 20 in wide, but on a map of 800 in a
+    label is wider than that, and labels of places 25 in apart were drawn over one another
+    (``10.910.5 s``)."""
+    from .world import inward
+
+    drawn: list[tuple[Annotation, list]] = []
+
+    def label(place: list) -> Annotation:
+        x, y, count, first, last = place
+        when = f"{first:.1f} s" if count == 1 else f"{count}×, {first:.1f}-{last:.1f} s"
+        return ax.annotate(when, (x, y), fontsize=7, zorder=6, **inward(ax, x, y),
+                           bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                                 "alpha": 0.8})
+
+    for place in places:
+        text = label(list(place))
+        box = text.get_window_extent().padded(2)     # (the figure's renderer, any canvas)
+        over = next((d for d in drawn if d[0].get_window_extent().padded(2).overlaps(box)),
+                    None)
+        if over is None:
+            drawn.append((text, list(place)))
+            continue
+        text.remove()
+        old, into = over
+        into[2] += place[2]
+        into[3], into[4] = min(into[3], place[3]), max(into[4], place[4])
+        old.remove()
+        drawn[drawn.index(over)] = (label(into), into)
