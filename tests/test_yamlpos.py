@@ -71,6 +71,45 @@ def test_the_commonest_yaml_mistakes_are_said_in_words_with_what_was_expected(
     assert err.expected == expected if expected is None else expected in err.expected
 
 
+@pytest.mark.parametrize("text,where,words,expected", [
+    ("name: a\n---\nname: b\n", (2, 1), "a second document (`---`) after the first",
+     "one document in the file"),
+    ("name: a\n...\nname: b\n", (3, 1), "text after the end of the document",
+     "nothing after a `...` line"),
+    ("name: a\nfoo\nbar: 1\n", (2, 1), "a line that is neither `key: value` nor `- item`",
+     "`key: value`"),
+    ("a:\n  - 1\n  b: 2\n", (3, 3), "a key among the `- ` items of a list",
+     "the key indented as the keys of the item above it (past its `- `)"),
+    ("a:\n  b: 1\n  - 2\n", (3, 3), "a `- ` list item among the keys of a mapping",
+     "the list under a key of its own"),
+    ("a: [1, 2] x\n", (1, 11), "more after the value on this line", "one value after `key:`"),
+    ('a: "b" c\n', (1, 8), "more after the value on this line", "one value after `key:`"),
+    ("a:\n  - 1\n - 3\n", (3, 2), "this line's indentation matches no key or list above it",
+     "the indentation of a key or a `- ` item above it"),
+    ("points: - a\n", (1, 9), "a `- ` list item on the line of its key",
+     "the items on lines of their own below the key"),
+    ("a: ?\n", (1, 4), "`?` cannot start a value", 'the value in quotes: "?"'),
+    ("a: *\n", (1, 4), "`*` cannot start a value", "the value in quotes"),
+    ("a: & b\n", (1, 4), "`&` cannot start a value", "the value in quotes"),
+    ("name: @foo\n", (1, 7), "`@` cannot start a value", 'the value in quotes: "@'),
+    ("name: `foo`\n", (1, 7), "`` ` `` cannot start a value", "the value in quotes"),
+    ("a: }\n", (1, 4), "`}` cannot start a value", "the value in quotes"),
+    ("a: , b\n", (1, 4), "`,` cannot start a value", "the value in quotes"),
+    ("a: |+x\n", (1, 6), "after `|` or `>` (a block of text) only", "the text on the lines"),
+])
+def test_pyyamls_inner_words_are_never_shown(text, where, words, expected):
+    """"but found another document", "expected <block end>, but found '?'", "could not find
+    expected ':'", "expected the node content, but found '}'": PyYAML's parser talking to
+    itself, shown as the error of a world, term set or map file."""
+    with pytest.raises(TermSetError) as info:
+        yamlpos.load(text, "f.yaml", TermSetError)
+    err = info.value
+    assert (err.span.line, err.span.column) == where, err.render()
+    assert words in err.message and expected in (err.expected or ""), err.render()
+    for inner in ("<", "found", "expected", "node", "token", "indicator"):
+        assert inner not in err.message, err.message
+
+
 @pytest.mark.parametrize("written, hint", [
     ("70in", "write the number alone, without `in`: the numbers are in inches"),
     ("-4.5 in/s", "write the number alone, without `in/s`: the numbers are in inches"),
