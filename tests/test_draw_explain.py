@@ -275,3 +275,43 @@ def test_study_clearance_panels_keep_a_long_worlds_name_over_its_own_panel(tmp_p
         title, panel = ax.title.get_window_extent(), ax.get_window_extent()
         assert panel.x0 - 20 <= title.x0 and title.x1 <= panel.x1 + 20, ax.get_title()
     assert fig.axes[0].get_title().replace("\n", "") == worlds[0][:-5]
+
+
+EIGHT = """\
+name: eight
+seed: 2
+dt: 0.05
+time_limit: 8
+robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}
+q_init: {x: 20, y: 0, heading: 0}
+q_goal: {x: 400, y: 300}
+map:
+  corridors:
+    - points: [[0, 0], [400, 0], [400, 320]]
+      width: 80
+obstacles:
+  - {name: box1, shape: circle, at: [200, -10], radius: 10}
+  - {name: crate, shape: rectangle, at: [410, 150], length: 20, width: 20, angle: 30}
+robots:
+""" + "".join(f"  - name: r{k}\n    q_init: {{x: {20 + 45 * k}, y: {-20 if k % 2 else 20}, "
+              f"heading: 0}}\n    q_goal: {{x: 400, y: {300 - 35 * k}}}\n" for k in range(1, 8))
+
+
+def test_eight_robots_are_told_apart_and_one_collision_place_has_one_label(tmp_path):
+    """Of eight robots, `robot` and `r6` were drawn in one blue and `r1` and `r7` in one
+    orange, and r3 and r4, which ran into each other 23 in apart, had two labels
+    `collision at 5.05 s` drawn over one another."""
+    path = tmp_path / "eight.yaml"
+    path.write_text(EIGHT, encoding="utf-8")
+    res = simulate(load_world(path))
+    assert res.robot_outcomes.count("collision") == 2
+    fig = draw_run(res)
+    ax = fig.axes[0]
+    names = {a.name for a in res.world.agents}
+    paths = [ln for ln in ax.lines if ln.get_label().split(":")[0] in names]
+    assert len(paths) == 8
+    assert len({(ln.get_color(), ln.get_linestyle()) for ln in paths}) == 8
+    fig.canvas.draw()
+    labels = [t.get_window_extent() for t in ax.texts if t.get_text().startswith("collision")]
+    assert labels and not any(a.overlaps(b) for k, a in enumerate(labels)
+                              for b in labels[k + 1:])
