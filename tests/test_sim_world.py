@@ -608,6 +608,24 @@ def test_an_empty_world_name_says_so():
         assert exc.value.message == "the world's name is empty"
 
 
+def test_a_world_from_standard_input_is_refused_in_words(tmp_path, monkeypatch, capsys):
+    """`cat w.yaml | mitos simulate -`, as `mitos eval --batch -` and `mitos teach --lesson -`
+    read standard input, said "world file `-` not found" and listed the packaged worlds."""
+    from mitos_cli.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path("-")
+    assert exc.value.message == ("a world is read from its file, not from standard input "
+                                 "(`-`)")
+    assert exc.value.hint == ("save it to a file and name that (a map it names is found "
+                              "beside the world's file)")
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "-"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and "not from standard input (`-`)" in err, err
+
+
 def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatch):
     (tmp_path / "w").mkdir()
     (tmp_path / "w" / "tiny.yaml").write_text(BASE)

@@ -1400,6 +1400,10 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     if found is not None:
         return found
     where = Path(name) if base is None else base / name
+    if str(name) == "-":            # as `eval --batch -` and `teach --lesson -` read stdin
+        raise UnknownWorld("a world is read from its file, not from standard input (`-`)",
+                           hint="save it to a file and name that (a map it names is found "
+                                "beside the world's file)")
     if is_dir(where):
         raise UnknownWorld(f"`{name}` is a directory, not a world file",
                            hint="name one of the world files (.yaml) in it")
