@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
     from matplotlib.text import Annotation
+    from matplotlib.transforms import Bbox
 
     from ..sim.loop import Scene
     from ..sim.world import World
@@ -85,26 +86,31 @@ def _label_collisions(ax: Axes, places: list[tuple[float, float, int, float, flo
     (``10.910.5 s``)."""
     from .world import inward
 
-    drawn: list[tuple[Annotation, list]] = []
+    ax.apply_aspect()       # the map's equal aspect, as drawn: the boxes are measured on it
+    drawn: list[tuple[Annotation, list, Bbox]] = []     # each label, its place, its box
 
-    def label(place: list) -> Annotation:
+    def label(place: list) -> tuple[Annotation, list, Bbox]:
         x, y, count, first, last = place
         when = f"{first:.1f} s" if count == 1 else f"{count}×, {first:.1f}-{last:.1f} s"
-        return ax.annotate(when, (x, y), fontsize=7, zorder=6, **inward(ax, x, y),
+        text = ax.annotate(when, (x, y), fontsize=7, zorder=6, **inward(ax, x, y),
                            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
                                  "alpha": 0.8})
+        return text, place, text.get_window_extent().padded(3)   # (the figure's renderer)
+
+    def meeting(box: Bbox, but: int = -1) -> int | None:
+        return next((k for k, d in enumerate(drawn) if k != but and d[2].overlaps(box)), None)
 
     for place in places:
-        text = label(list(place))
-        box = text.get_window_extent().padded(2)     # (the figure's renderer, any canvas)
-        over = next((d for d in drawn if d[0].get_window_extent().padded(2).overlaps(box)),
-                    None)
-        if over is None:
-            drawn.append((text, list(place)))
-            continue
-        text.remove()
-        old, into = over
-        into[2] += place[2]
-        into[3], into[4] = min(into[3], place[3]), max(into[4], place[4])
-        old.remove()
-        drawn[drawn.index(over)] = (label(into), into)
+        drawn.append(label(list(place)))
+        at = len(drawn) - 1
+        # merged, a label grows ("12×, 5.1-49.8 s"), and may meet another: merge on
+        while (other := meeting(drawn[at][2], at)) is not None:
+            keep, gone = min(at, other), max(at, other)
+            into, more = drawn[keep][1], drawn[gone][1]
+            into[2] += more[2]
+            into[3], into[4] = min(into[3], more[3]), max(into[4], more[4])
+            for text, _, _ in (drawn[keep], drawn[gone]):
+                text.remove()
+            del drawn[gone]
+            drawn[keep] = label(into)
+            at = keep

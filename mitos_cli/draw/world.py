@@ -296,6 +296,7 @@ def _draw_robot(ax: Axes, result: SimResult, i: int, agent: Agent, every: int, v
                             fontsize=7.5, zorder=7, **inward(ax, x, y),
                             bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
                                   "alpha": 0.85})
+        ax.apply_aspect()   # the map's equal aspect, as drawn: the boxes are measured on it
         box = label.get_window_extent().padded(2)
         if any(t is not label and t.get_text() == label.get_text()
                and t.get_window_extent().padded(2).overlaps(box) for t in ax.texts):
