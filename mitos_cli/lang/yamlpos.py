@@ -236,7 +236,9 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
         unclosed = exc.problem == "found unexpected end of stream" and "quoted" in (exc.context or "")
         # a key without its `:` is found missing on the next line; a bare `*` or `&` after it
         at_start = unclosed or exc.problem == "could not find expected ':'" or \
-            (exc.context or "") in ("while scanning an alias", "while scanning an anchor")
+            (exc.context or "") in ("while scanning an alias", "while scanning an anchor",
+                                    "while parsing a tag", "while scanning a tag",
+                                    "while scanning a directive")
         mark = (exc.context_mark if at_start else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
         problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
@@ -332,20 +334,38 @@ def _in_words(problem: str, context: str | None) -> tuple[str, str | None]:
         return ("a `- ` list item on the line of its key",
                 "the items on lines of their own below the key, indented (`- a`), or a list in "
                 "brackets (`[a, b]`); a text that starts with `- ` in quotes")
+    if context == "while scanning a directive":
+        return ("`%` at the start of a line begins a YAML directive",
+                "the key without `%`, or in quotes")
+    if problem.startswith("expected the node content, but found '<stream end>'"):
+        return ("the file ends where a value should start",
+                "a value there, and each `[` and `{` closed")
     starts = _VALUE_STARTS.match(problem)
     char = (starts.group(1) or starts.group(2)) if starts else \
-        {"while scanning an alias": "*", "while scanning an anchor": "&"}.get(context or "")
+        {"while scanning an alias": "*", "while scanning an anchor": "&",
+         "while parsing a tag": "!", "while scanning a tag": "!"}.get(context or "")
     if problem == "mapping keys are not allowed here":
         char = "?"
     if char is not None:
         shown = "`` ` ``" if char == "`" else f"`{char}`"
         return (f"{shown} cannot start a value in YAML",
                 'the value in quotes: "?"' if char == "?" else f'the value in quotes: "{char}..."')
-    if problem.startswith("expected chomping or indentation indicators"):
-        return ("after `|` or `>` (a block of text) only `+`, `-` or a digit may follow on its "
-                "line", "the text on the lines below, indented, or the value in quotes")
-    return (problem.replace("'<stream end>'", "the end of the file")
-            .replace("'<scalar>'", "a value")), None
+    if context == "while scanning a block scalar":
+        return ("after `|` or `>` (a block of text) only `+`, `-` or a digit from 1 to 9 may "
+                "follow on its line", "the text on the lines below, indented, or the value in "
+                "quotes")
+    return _TOKEN_NAMES.sub(lambda m: _TOKENS[m.group(0)], problem), None
+
+
+#: PyYAML's names of its tokens, in words (for its messages not said otherwise above)
+_TOKENS = {"'<stream end>'": "the end of the file", "'<scalar>'": "a value",
+           "'<tag>'": "a tag (`!`)", "'<anchor>'": "an anchor (`&`)", "'<alias>'": "an alias (`*`)",
+           "'<block mapping start>'": "a key", "'<block sequence start>'": "a `- ` item",
+           "'<block end>'": "less indentation", "<block end>": "less indentation",
+           "'<flow sequence start>'": "`[`", "'<flow mapping start>'": "`{`",
+           "'<document start>'": "`---`", "'<document end>'": "`...`",
+           "'<directive>'": "a `%` directive"}
+_TOKEN_NAMES = re.compile("|".join(re.escape(t) for t in sorted(_TOKENS, key=len, reverse=True)))
 
 
 def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],
