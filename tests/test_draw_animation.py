@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from mitos_cli.cli.app import app, main
 from mitos_cli.draw.animation import animate_run, frame_ticks
-from mitos_cli.draw.frame import ROBOT_COLOUR
+from mitos_cli.draw.frame import ROBOT_COLOUR, TRAIL_COLOUR
 from mitos_cli.errors import InputError
 from mitos_cli.resources import packaged_path
 
@@ -165,3 +165,31 @@ def test_an_animation_written_onto_a_link_goes_to_the_file_it_names(short_world,
     assert link.is_symlink() and (real / "run.gif").read_bytes()[:3] == b"GIF"
     assert (real / "run.gif").stat().st_mode & 0o777 == 0o600
     assert not list(tmp_path.glob("**/.*.part.*"))
+
+
+def test_each_robot_of_an_animation_takes_its_colour_in_the_runs_picture():
+    """`back`, the third robot of a crossroads world, was teal in `--plot` and purple in
+    `--animate`, the first robot's trail green beside its blue path; past five robots the
+    animation's colours came round again."""
+    from matplotlib.figure import Figure
+
+    from mitos_cli.draw.animation import _robot_patches
+    from mitos_cli.draw.world import ROBOT_COLOURS, ROBOT_STYLES
+    from mitos_cli.sim import load_world
+
+    world = load_world(packaged_path("worlds", "multirobot.yaml"))
+    agent = world.agents[1]
+    eight = dataclasses.replace(world, agents=(world.agents[0], *[
+        dataclasses.replace(agent, name=f"r{k}") for k in range(1, 8)]))
+    ax = Figure().add_subplot()
+    robots, trails = _robot_patches(ax, eight, 8)
+    import matplotlib.colors as mc
+
+    bodies = [mc.to_hex(body.get_facecolor()) for _, body in robots]
+    assert bodies == [ROBOT_COLOURS[i % 6] for i in range(8)]
+    assert [(mc.to_hex(t.get_color()), t.get_linestyle()) for t in trails] == [
+        (ROBOT_COLOURS[i % 6], ROBOT_STYLES[i // 6]) for i in range(8)]
+    alone = load_world(packaged_path("worlds", "corridor.yaml"))
+    ((_, body),), (trail,) = _robot_patches(Figure().add_subplot(), alone, 1)
+    assert (mc.to_hex(body.get_facecolor()), mc.to_hex(trail.get_color())) == (
+        ROBOT_COLOUR, TRAIL_COLOUR)                     # one robot: blue, its trail green

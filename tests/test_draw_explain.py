@@ -224,3 +224,94 @@ def test_study_plots_draw_dollars_as_written(tmp_path):
                               rates={"success": rate})
     study.success_bars([summary], ["w $x^$"], ["a $x^$"], tmp_path / "s.png")
     assert (tmp_path / "c.png").stat().st_size > 0 and (tmp_path / "s.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("worlds", [
+    ["a_rather_long_world_file_name_for_the_corridor.yaml", "ok.yaml", "b31.yaml",
+     "all worlds"],
+    ["corridor", "slalom", "figure4"],
+    [f"w{k}_{'x' * (k % 3) * 9}.yaml" for k in range(9)]])
+def test_study_success_bars_never_write_one_worlds_name_over_anothers(tmp_path, monkeypatch,
+                                                                     worlds):
+    """`mitos compare a_rather_long_world_file_name_for_the_corridor.yaml ok.yaml b31.yaml`
+    wrote the first name across the second (`..._for_the_corrok dor`)."""
+    from types import SimpleNamespace
+
+    from mitos_cli.draw import study
+
+    labels = ["fuzzy and=min", "fuzzy and=product", "potential_field", "dwa"]
+    seen = []
+    monkeypatch.setattr(study, "_save", lambda fig, plt, path: seen.append(fig))
+    rate = SimpleNamespace(k=1, n=2, lo=0.1, hi=0.9)
+    summaries = [SimpleNamespace(world=w, choice=SimpleNamespace(label=c),
+                                 rates={"success": rate}) for w in worlds for c in labels]
+    study.success_bars(summaries, worlds, labels, tmp_path / "s.png")
+    fig = seen[0]
+    fig.canvas.draw()
+    boxes = [t.get_window_extent() for t in fig.axes[0].get_xticklabels()]
+    assert len(boxes) == len(worlds)
+    for a, b in zip(boxes, boxes[1:]):
+        assert not a.overlaps(b), (a, b)
+    assert all(b.x0 >= 0 and b.x1 <= fig.bbox.width and b.y0 >= 0 for b in boxes)
+    (legend,) = fig.legends or [fig.axes[0].get_legend()]
+    key = legend.get_window_extent()
+    assert not any(key.overlaps(b) for b in boxes) and key.y0 >= 0
+
+
+def test_study_clearance_panels_keep_a_long_worlds_name_over_its_own_panel(tmp_path,
+                                                                           monkeypatch):
+    """A world's name wider than its panel ran into the next panel's title."""
+    from mitos_cli.draw import study
+
+    worlds = ["the_long_corridor_with_two_boxes_and_a_cart_on_the_left_side.yaml", "ok.yaml",
+              "b31.yaml"]
+    rows = [{"world": w, "min_clearance_in": v, "c": "x"} for w in worlds for v in (1.0, 2.0)]
+    seen = []
+    monkeypatch.setattr(study, "_save", lambda fig, plt, path: seen.append(fig))
+    study.clearance_boxes(rows, worlds, ["x"], lambda r: r["c"], tmp_path / "c.png")
+    fig = seen[0]
+    fig.canvas.draw()
+    for ax in fig.axes[:3]:
+        title, panel = ax.title.get_window_extent(), ax.get_window_extent()
+        assert panel.x0 - 20 <= title.x0 and title.x1 <= panel.x1 + 20, ax.get_title()
+    assert fig.axes[0].get_title().replace("\n", "") == worlds[0][:-5]
+
+
+EIGHT = """\
+name: eight
+seed: 2
+dt: 0.05
+time_limit: 8
+robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}
+q_init: {x: 20, y: 0, heading: 0}
+q_goal: {x: 400, y: 300}
+map:
+  corridors:
+    - points: [[0, 0], [400, 0], [400, 320]]
+      width: 80
+obstacles:
+  - {name: box1, shape: circle, at: [200, -10], radius: 10}
+  - {name: crate, shape: rectangle, at: [410, 150], length: 20, width: 20, angle: 30}
+robots:
+""" + "".join(f"  - name: r{k}\n    q_init: {{x: {20 + 45 * k}, y: {-20 if k % 2 else 20}, "
+              f"heading: 0}}\n    q_goal: {{x: 400, y: {300 - 35 * k}}}\n" for k in range(1, 8))
+
+
+def test_eight_robots_are_told_apart_and_one_collision_place_has_one_label(tmp_path):
+    """Of eight robots, `robot` and `r6` were drawn in one blue and `r1` and `r7` in one
+    orange, and r3 and r4, which ran into each other 23 in apart, had two labels
+    `collision at 5.05 s` drawn over one another."""
+    path = tmp_path / "eight.yaml"
+    path.write_text(EIGHT, encoding="utf-8")
+    res = simulate(load_world(path))
+    assert res.robot_outcomes.count("collision") == 2
+    fig = draw_run(res)
+    ax = fig.axes[0]
+    names = {a.name for a in res.world.agents}
+    paths = [ln for ln in ax.lines if ln.get_label().split(":")[0] in names]
+    assert len(paths) == 8
+    assert len({(ln.get_color(), ln.get_linestyle()) for ln in paths}) == 8
+    fig.canvas.draw()
+    labels = [t.get_window_extent() for t in ax.texts if t.get_text().startswith("collision")]
+    assert labels and not any(a.overlaps(b) for k, a in enumerate(labels)
+                              for b in labels[k + 1:])

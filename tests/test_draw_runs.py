@@ -93,3 +93,40 @@ def test_plot_of_several_worlds_is_refused(rear_end, tmp_path):
     assert res.exit_code == 2
     assert "--plot draws one world" in res.output
     assert not (tmp_path / "runs.png").exists()
+
+
+LONG = """\
+name: long
+dt: 0.05
+time_limit: 10
+robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}
+q_init: {x: 30, y: 0}
+q_goal: {x: 1970, y: 0}
+map:
+  corridors:
+    - points: [[0, 0], [2000, 0]]
+      width: 80
+"""
+
+
+def test_collision_labels_that_would_overlap_in_the_picture_share_one():
+    """Collisions 25 in apart, more than the 20 in that share a label, on a map 2,000 in long
+    (25 in is 0.1 in of the picture): each had its own label, drawn over one another
+    (`10.910.5 s`)."""
+    pytest.importorskip("matplotlib")
+    from mitos_cli.draw.runs import draw_runs
+    from mitos_cli.sim.loop import prepare
+    from mitos_cli.sim.worldfile import parse_world
+
+    world = parse_world(LONG, "long.yaml")
+    runs = [_summary(s, "collision", [[[0, 0], [900 + 25 * s, 0]]], ["collision"],
+                     t_end=10.0 + s / 10) for s in range(4)]
+    runs.append(_summary(9, "collision", [[[0, 0], [1500, 0]]], ["collision"], t_end=20.0))
+    overlay = runs_overlay("long", runs, ["robot"])
+    assert len(overlay.collision_places()) == 5          # 25 in apart: not within 20 in
+    fig = draw_runs(overlay, world, prepare(world))
+    fig.canvas.draw()                     # as drawn: the map's equal aspect applied
+    labels = [t for t in fig.axes[0].texts if t.get_text().endswith(" s")]
+    assert sorted(t.get_text() for t in labels) == ["20.0 s", "4×, 10.0-10.3 s"]
+    boxes = [t.get_window_extent() for t in labels]
+    assert not boxes[0].overlaps(boxes[1])

@@ -145,3 +145,21 @@ def test_footprint_every_that_is_no_time_is_refused(every):
         draw_run(result, footprint_every=every)
     draw_run(result, footprint_every=1e308)              # one footprint: the first tick's
     draw_run(result, footprint_every=0)                  # every tick
+
+
+def test_the_pictures_title_shows_a_clearance_below_the_margin_as_below_it():
+    """A run that came 1.99 in from what it passed, under a safety margin of 2 in: the verdict
+    printed `min clearance 1.99 in; closer than the safety margin (2 in)` while the picture's
+    title (and the result's repr) said `min clearance 2.0 in`."""
+    pytest.importorskip("matplotlib")
+    from mitos_cli.draw.world import draw_run
+    from mitos_cli.sim.loop import simulate
+    from mitos_cli.sim.worldfile import parse_world
+
+    run = simulate(parse_world(WORLD, "tiny.yaml"))
+    assert run.world.agents[0].robot.safety_margin == 2
+    near = dataclasses.replace(run, metrics={**run.metrics, "min_clearance_in": 1.9888})
+    assert "min clearance 1.99 in)" in draw_run(near).axes[0].get_title()
+    assert repr(near).endswith("min clearance 1.99 in>")
+    assert "min clearance 2.0 in" in draw_run(dataclasses.replace(
+        run, metrics={**run.metrics, "min_clearance_in": 2.0111})).axes[0].get_title()

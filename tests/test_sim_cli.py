@@ -407,6 +407,36 @@ def test_the_verdict_prints_a_clearance_on_the_side_of_the_margin_it_lies():
     assert _verdict(run(-0.1, "collision")).endswith("min clearance -0.1 in")
 
 
+def test_the_verdict_names_every_robot_that_came_closer_than_its_margin():
+    """Of two robots, `closer than the safety margin (two) (2 in)` read as a margin named
+    `two`, and a second robot as close was not named."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from mitos_cli.cli.simulate_cmd import _verdict
+    from mitos_cli.sim.world import Robot
+
+    def run(*clears: float, margins: tuple[float, ...] = (2, 2)) -> SimpleNamespace:
+        agents = [SimpleNamespace(name=n, robot=replace(Robot(), safety_margin=m))
+                  for n, m in zip(("robot", "two"), margins)]
+        each = [{"min_clearance_in": c} for c in clears]
+        m = {"time_s": 1.0, "min_clearance_in": min(clears)}
+        return SimpleNamespace(metrics=m, world=SimpleNamespace(agents=agents, name="w"),
+                               robot_metrics=each, outcome="success",
+                               robot_outcomes=["success"] * 2, seed=1, planner="fuzzy:drive")
+
+    assert _verdict(run(2.2, 0.4)).endswith(
+        "min clearance 0.4 in; two came closer than its safety margin (2 in)")
+    assert _verdict(run(1.1, 1.1)).endswith(
+        "min clearance 1.1 in; robot and two came closer than their safety margin (2 in)")
+    assert _verdict(run(2.5, 2.5, margins=(3, 2))).endswith(
+        "min clearance 2.5 in; robot came closer than its safety margin (3 in)")
+    assert _verdict(run(1.5, 2.5, margins=(2, 3))).endswith(
+        "min clearance 1.5 in; robot came closer than its safety margin (2 in), two than its "
+        "(3 in)")
+    assert _verdict(run(2.5, 2.5)).endswith("min clearance 2.5 in")
+
+
 def test_one_run_shows_no_spread():
     out = CliRunner().invoke(app, ["simulate", "corridor.yaml", "--runs", "1"]).stdout
     row = out.splitlines()[1].split()

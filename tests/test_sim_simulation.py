@@ -158,6 +158,25 @@ def test_a_route_given_out_cannot_be_changed_under_the_run():
     same_run(sim.result(), simulate(world, seed=1))
 
 
+@pytest.mark.parametrize("k, i, says", [
+    (60, 0, "k is a tick of the run, 0 to 59, not `60`"),
+    (-1, 0, "k is a tick of the run, 0 to 59, not `-1`"),
+    (2.0, 0, "k is a tick of the run, 0 to 59, not `2.0`"),
+    (10, 1, "i is the index of one of the run's 1 robot, 0 to 0, not `1`"),
+    (10, -1, "i is the index of one of the run's 1 robot, 0 to 0, not `-1`"),
+    (10, True, "i is the index of one of the run's 1 robot, 0 to 0, not `True`")])
+def test_route_at_a_tick_or_robot_the_run_does_not_have_is_refused(k, i, says):
+    """`route_at(100000, 0)` gave the last route of a 60-tick run without a word (and -5 the
+    first), and `route_at(10, 1)` of one robot met `IndexError: tuple index out of range`."""
+    from mitos_cli.errors import InputError
+
+    res = simulate(short("corridor.yaml", 3.0), seed=1)
+    assert res.ticks == 60 and res.route_at(59, 0) is res.route_at(np.int64(0), 0)
+    with pytest.raises(InputError) as info:
+        res.route_at(k, i)
+    assert str(info.value) == f"input error: {says}"
+
+
 def test_the_verdicts_end_the_run():
     world = load_world(packaged_path("worlds", "figure4.yaml"))     # collides at B
     sim = Simulation(world)

@@ -608,6 +608,24 @@ def test_an_empty_world_name_says_so():
         assert exc.value.message == "the world's name is empty"
 
 
+def test_a_world_from_standard_input_is_refused_in_words(tmp_path, monkeypatch, capsys):
+    """`cat w.yaml | mitos simulate -`, as `mitos eval --batch -` and `mitos teach --lesson -`
+    read standard input, said "world file `-` not found" and listed the packaged worlds."""
+    from mitos_cli.cli.app import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(WorldError) as exc:
+        resolve_world_path("-")
+    assert exc.value.message == ("a world is read from its file, not from standard input "
+                                 "(`-`)")
+    assert exc.value.hint == ("save it to a file and name that (a map it names is found "
+                              "beside the world's file)")
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "-"])
+    err = capsys.readouterr().err
+    assert info.value.code == 1 and "not from standard input (`-`)" in err, err
+
+
 def test_a_misspelt_world_path_points_at_the_file_beside_it(tmp_path, monkeypatch):
     (tmp_path / "w").mkdir()
     (tmp_path / "w" / "tiny.yaml").write_text(BASE)
@@ -854,6 +872,16 @@ def test_a_corridor_in_metres_gets_a_hint_about_units():
            "the robot (18 in wide); if 1.8 is metres, write 71" in text
     text = error(BASE.replace("width: 70", "width: 1.8").replace("y: 0, heading", "y: 30, heading"))
     assert "lies inside a wall" in text and "lengths in a world are inches" in text
+
+
+@pytest.mark.parametrize("width", ["0.3", "0.001"])
+def test_the_units_hint_offers_no_metres_that_are_still_too_narrow(width):
+    """`width: 0.3` said "if 0.3 is metres, write 12", a corridor still narrower than the
+    18 in robot, and `width: 0.001` "write 0", which the reader refuses."""
+    text = error(BASE.replace("width: 70", f"width: {width}"))
+    assert (f"hint: lengths in a world are inches: a corridor `width: {width}` is narrower "
+            "than the robot (18 in wide)\n") in text + "\n"
+    assert "is metres" not in text
 
 
 OBSTACLES = ("obstacles:\n"

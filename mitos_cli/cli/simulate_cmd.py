@@ -53,14 +53,27 @@ def _verdict(res: SimResult) -> str:
              if r["min_clearance_in"] < a.robot.safety_margin]
     near = ""
     if close and res.outcome != "collision":
-        who = f" ({close[0].name})" if len(agents) > 1 else ""
-        near = (f"; closer than the safety margin{who} "
-                f"({close[0].robot.safety_margin:g} in)")
+        near = f"; closer than the safety margin ({close[0].robot.safety_margin:g} in)"
+        if len(agents) > 1:                 # "(two) (2 in)" read as a margin named `two`
+            near = "; " + _who_came_close(close)
     others = ("" if len(agents) == 1 else " (" + ", ".join(
         f"{a.name} {o}" for a, o in zip(agents, res.robot_outcomes)) + ")")
     shown = clearance(m["min_clearance_in"], close[0].robot.safety_margin if near else None)
     return (f"{res.world.name}: {res.outcome.upper()}{others} after {m['time_s']:.2f} s "
             f"(seed {res.seed}, {res.planner}); min clearance {shown} in{near}")
+
+
+def _who_came_close(close: list) -> str:
+    """``two came closer than its safety margin (2 in)``, ``robot and two came closer than
+    their safety margin (2 in)``, or each with its own margin where they differ."""
+    margins = [a.robot.safety_margin for a in close]
+    if len(set(margins)) == 1:
+        names = close[0].name if len(close) == 1 else \
+            ", ".join(a.name for a in close[:-1]) + f" and {close[-1].name}"
+        return (f"{names} came closer than {'its' if len(close) == 1 else 'their'} safety "
+                f"margin ({margins[0]:g} in)")
+    return f"{close[0].name} came closer than its safety margin ({margins[0]:g} in), " + \
+        ", ".join(f"{a.name} than its ({m:g} in)" for a, m in zip(close[1:], margins[1:]))
 
 
 def _table(rows: list[tuple[str, ...]]) -> str:

@@ -40,7 +40,6 @@ if TYPE_CHECKING:
 
 FORMATS = ("gif", "mp4")
 BARS = 8                    # fired rules shown, by DOF
-OTHER_ROBOTS = ("#d17a00", "#7b3fa0", "#008b8b", "#a0522d")
 #: frames per second, as ``mitos simulate --fps`` takes them
 FPS = (0.1, 60.0)
 #: the picture's width in pixels (the CLI's is 720)
@@ -233,16 +232,21 @@ def _obstacle_patches(ax: Axes, world: World) -> list:
 
 
 def _robot_patches(ax: Axes, world: World, n: int) -> tuple[list, list]:
-    """Each robot's body (with its robot) and trail: the first in the robot's colours, the
-    others in :data:`OTHER_ROBOTS`."""
+    """Each robot's body (with its robot) and trail: one robot blue with a green trail;
+    several each in its colour and line style of ``--plot``'s picture of the run
+    (:data:`~mitos_cli.draw.world.ROBOT_COLOURS`; the third robot was teal there and purple
+    here, and past five robots the colours came round again)."""
     from matplotlib.patches import Polygon
 
-    colours = [ROBOT_COLOUR] + [OTHER_ROBOTS[i % len(OTHER_ROBOTS)] for i in range(n - 1)]
+    from .world import ROBOT_COLOURS, ROBOT_STYLES
+
     robots, trails = [], []
     for i, agent in enumerate(world.agents):
-        (trail,) = ax.plot([], [], color=TRAIL_COLOUR if i == 0 else colours[i], lw=1.6,
+        colour = ROBOT_COLOURS[i % len(ROBOT_COLOURS)] if n > 1 else ROBOT_COLOUR
+        (trail,) = ax.plot([], [], color=colour if n > 1 else TRAIL_COLOUR, lw=1.6,
+                           ls=ROBOT_STYLES[i // len(ROBOT_COLOURS) % len(ROBOT_STYLES)],
                            alpha=1.0 if i == 0 else 0.6, zorder=4)
-        body = Polygon(np.zeros((4, 2)), closed=True, facecolor=colours[i], edgecolor="black",
+        body = Polygon(np.zeros((4, 2)), closed=True, facecolor=colour, edgecolor="black",
                        lw=0.6, zorder=5)
         ax.add_patch(body)
         robots.append((agent.robot, body))

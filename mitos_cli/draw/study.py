@@ -5,6 +5,7 @@ matplotlib is imported inside the functions (Agg backend), so importing this mod
 
 from __future__ import annotations
 
+import re
 import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -103,15 +104,24 @@ def success_bars(summaries: Sequence[_Summary], worlds: list[str], labels: list[
                         color=cmap(j % 10))
     ax.set_xticks(x)
     names = _names(worlds)
-    ax.set_xticklabels([names[w] for w in worlds], rotation=15 if n_w > 4 else 0)
+    # a name wider than its group is broken into lines that fit it: one line each (or at
+    # 15 deg past four worlds), a long name ran across its neighbours' ("..._corrok dor")
+    from matplotlib.font_manager import FontProperties
+
+    size = FontProperties(size=plt.rcParams["xtick.labelsize"]).get_size_in_points()
+    group = fig.get_figwidth() * 72 * 0.8 / max(1, n_w)          # points
+    chars = max(4, int(0.9 * group / (0.65 * size)))
+    ax.set_xticklabels([_broken(names[w], chars) for w in worlds])
     ax.set_ylim(0, 105)
     ax.set_ylabel("success rate (%)")
     ax.set_title("Success rate per world (whiskers: Wilson 95% interval)")
     ax.grid(axis="y", alpha=0.3)
-    ax.legend(fontsize=8, ncol=min(3, n_c), loc="upper center", bbox_to_anchor=(0.5, -0.12),
-              frameon=False)
+    # the key at the foot of the figure, under the names however many lines they take (below
+    # the axes by a fixed fraction, it lay over a name broken into five lines)
+    ncol = min(3, n_c)
+    fig.legend(fontsize=8, ncol=ncol, loc="lower center", frameon=False)
     literal_text(fig)                   # before the layout measures a world's or choice's name
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, (0.1 + 0.2 * -(-n_c // ncol)) / fig.get_figheight(), 1, 1))
     return _save(fig, plt, path)
 
 
@@ -143,7 +153,7 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
         ax.axhline(0.0, color="black", linewidth=0.6, alpha=0.6)
         ax.set_xticks(range(1, len(labels) + 1))
         ax.set_xticklabels([str(j + 1) for j in range(len(labels))])
-        ax.set_title(names[world], fontsize=10)
+        ax.set_title(_broken(names[world], int(4.2 * 72 * 0.8 / (0.65 * 10))), fontsize=10)
         ax.set_ylabel("min clearance (in)")
         ax.grid(axis="y", alpha=0.3)
     for k in range(n_w, n_rows * cols):
@@ -159,6 +169,26 @@ def clearance_boxes(rows: list[dict], worlds: list[str], labels: list[str],
     literal_text(fig)
     fig.tight_layout(rect=(0, (0.1 + 0.13 * len(legend)) / height, 1, 1))   # (and the title)
     return _save(fig, plt, path)
+
+
+def _broken(name: str, chars: int) -> str:
+    """``name`` in lines of at most ``chars`` characters, broken after a ``_``, ``-``, ``.``,
+    ``/`` or space where it can be, and inside a part longer than a line only there."""
+    lines: list[str] = []
+    line = ""
+    for part in re.findall(r"[^_\-./ ]*[_\-./ ]|[^_\-./ ]+", name):
+        if len(line) + len(part) <= chars:
+            line += part
+            continue
+        if line:
+            lines.append(line)
+        while len(part) > chars:
+            lines.append(part[:chars])
+            part = part[chars:]
+        line = part
+    if line or not lines:
+        lines.append(line)
+    return "\n".join(text.rstrip() or text for text in lines)
 
 
 def _packed(entries: list[str], width: int) -> list[str]:

@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from ..errors import InputError
-from ..words import clearance
 from .output import _matplotlib, finish, new_figure
 
 if TYPE_CHECKING:
@@ -34,6 +33,8 @@ RESERVED = (ROUTE_COLOUR, REPLANNED_COLOUR, *OBSTACLE_COLOURS, GOAL_COLOUR)
 #: a colour per robot where a world has several (the first is the footprint blue of the frames):
 #: none is one of ``RESERVED`` or near it (the third robot was the replanned route's purple)
 ROBOT_COLOURS = ("#1f5fbf", "#d9731e", "#1f9e89", "#c23b8a", "#8c6d31", "#c9a400")
+#: the paths' line styles, a round of the colours each: a seventh robot's path was the first's
+ROBOT_STYLES = ("-", "--", ":", "-.")
 TIME_STEPS = (1, 2, 5, 10, 15, 20, 30, 60, 120, 300, 600)     # s between time marks
 
 
@@ -169,7 +170,7 @@ def draw_run(result: SimResult, path: str | Path | None = None, *, footprint_eve
     ax.set_ylabel("y (in)")
     m = result.metrics
     ax.set_title(f"{world.name}: {result.outcome} after {m['time_s']:.2f} s "
-                 f"(seed {result.seed}, min clearance {clearance(m['min_clearance_in'])} in)",
+                 f"(seed {result.seed}, min clearance {result.shown_clearance()} in)",
                  fontsize=9)
     return finish(fig, path, show)
 
@@ -271,7 +272,8 @@ def _draw_robot(ax: Axes, result: SimResult, i: int, agent: Agent, every: int, v
                              closed=True, fill=False, edgecolor=colour, lw=0.5,
                              alpha=0.6 if several else 1.0))
     if several:
-        ax.plot(pose[:, 0], pose[:, 1], color=colour, lw=2.0,
+        style = ROBOT_STYLES[i // len(ROBOT_COLOURS) % len(ROBOT_STYLES)]
+        ax.plot(pose[:, 0], pose[:, 1], color=colour, lw=2.0, ls=style,
                 label=f"{agent.name}: {result.robot_outcomes[i]}")
     elif len(pose) > 1:
         segs = np.stack([pose[:-1, :2], pose[1:, :2]], axis=1)
@@ -287,11 +289,18 @@ def _draw_robot(ax: Axes, result: SimResult, i: int, agent: Agent, every: int, v
         x, y = pose[-1, :2]
         ax.plot(x, y, marker="x", ms=9, mew=2.0, color="black", zorder=7, ls="none",
                 label="collision" if "collision" not in result.robot_outcomes[:i] else None)
-        # the run's end: a robot parked at its goal keeps its own time to its arrival
-        ax.annotate(f"collision at {result.metrics['time_s']:.2f} s", (x, y),
-                    fontsize=7.5, zorder=7, **inward(ax, x, y),
-                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
-                          "alpha": 0.85})
+        # the run's end: a robot parked at its goal keeps its own time to its arrival; one
+        # label where another robot's would meet it (two that ran into each other had two,
+        # drawn over one another: the time is the run's, the same)
+        label = ax.annotate(f"collision at {result.metrics['time_s']:.2f} s", (x, y),
+                            fontsize=7.5, zorder=7, **inward(ax, x, y),
+                            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                                  "alpha": 0.85})
+        ax.apply_aspect()   # the map's equal aspect, as drawn: the boxes are measured on it
+        box = label.get_window_extent().padded(2)
+        if any(t is not label and t.get_text() == label.get_text()
+               and t.get_window_extent().padded(2).overlaps(box) for t in ax.texts):
+            label.remove()
     ax.plot(agent.start.x, agent.start.y, marker="o", color=GOAL_COLOUR, ms=5)
     ax.add_patch(Circle((agent.goal.x, agent.goal.y), agent.goal.tolerance, fill=False,
                         edgecolor=GOAL_COLOUR, lw=1.0, ls="--"))

@@ -234,7 +234,12 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
     except yaml.MarkedYAMLError as exc:
         unclosed_flow(exc, text, path, error)
         unclosed = exc.problem == "found unexpected end of stream" and "quoted" in (exc.context or "")
-        mark = (exc.context_mark if unclosed else None) or exc.problem_mark or exc.context_mark
+        # a key without its `:` is found missing on the next line; a bare `*` or `&` after it
+        at_start = unclosed or exc.problem == "could not find expected ':'" or \
+            (exc.context or "") in ("while scanning an alias", "while scanning an anchor",
+                                    "while parsing a tag", "while scanning a tag",
+                                    "while scanning a directive")
+        mark = (exc.context_mark if at_start else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
         problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
         raise error(f"invalid YAML: {problem}", span=span, expected=expected) from None
@@ -283,14 +288,84 @@ _WORDS = {
 }
 
 
+#: what PyYAML's parser expected a block's end (its next key or item, or less indentation)
+#: but found instead, in words: ``(problem, expected)``
+_BLOCK_END = {
+    "'?'": ("a key among the `- ` items of a list",
+            "the key indented as the keys of the item above it (past its `- `), or as the keys "
+            "above the list; or `- ` before it to begin an item"),
+    "'-'": ("a `- ` list item among the keys of a mapping",
+            "the list under a key of its own (`key:` on the line above, the items indented "
+            "below it), or a `key: value` here"),
+    "'<scalar>'": ("more after the value on this line",
+                   "one value after `key:`; a text with quotes or brackets in it in one pair "
+                   "of quotes"),
+}
+
+#: a character that starts something else in YAML (a key, an alias, an anchor, a tag, the
+#: end of a bracket), met where a value starts
+_VALUE_STARTS = re.compile(r"found character '(.)' that cannot start any token"
+                           r"|expected the node content, but found '(.)'")
+
+
 def _in_words(problem: str, context: str | None) -> tuple[str, str | None]:
-    """PyYAML's problem in plain words, with what was expected where PyYAML does not say."""
+    """PyYAML's problem in plain words, with what was expected where PyYAML does not say:
+    its parser's own words ("expected <block end>, but found '?'", "but found another
+    document") are never shown."""
     if problem in _WORDS:
         return _WORDS[problem]
     if problem == "found unexpected end of stream" and context and "quoted" in context:
         return "a quoted value is not closed before the end of the file", "its closing quote"
-    return (problem.replace("'<stream end>'", "the end of the file")
-            .replace("'<scalar>'", "a value")), None
+    if problem == "but found another document":
+        return ("a second document (`---`) after the first",
+                "one document in the file: remove this `---` and what follows it, or put that "
+                "in a file of its own")
+    if problem.startswith("expected '<document start>'"):
+        return ("text after the end of the document (a `...` line, or a `%` directive without "
+                "`---` after it)", "nothing after a `...` line: remove it")
+    if problem == "could not find expected ':'":
+        return ("a line that is neither `key: value` nor `- item` (no `:` after its key)",
+                "`key: value`, or `- item` in a list; a text of several lines in quotes")
+    if problem.startswith("expected <block end>, but found "):
+        return _BLOCK_END.get(problem.rsplit(" ", 1)[-1], (
+            "this line's indentation matches no key or list above it",
+            "the indentation of a key or a `- ` item above it"))
+    if problem == "sequence entries are not allowed here":
+        return ("a `- ` list item on the line of its key",
+                "the items on lines of their own below the key, indented (`- a`), or a list in "
+                "brackets (`[a, b]`); a text that starts with `- ` in quotes")
+    if context == "while scanning a directive":
+        return ("`%` at the start of a line begins a YAML directive",
+                "the key without `%`, or in quotes")
+    if problem.startswith("expected the node content, but found '<stream end>'"):
+        return ("the file ends where a value should start",
+                "a value there, and each `[` and `{` closed")
+    starts = _VALUE_STARTS.match(problem)
+    char = (starts.group(1) or starts.group(2)) if starts else \
+        {"while scanning an alias": "*", "while scanning an anchor": "&",
+         "while parsing a tag": "!", "while scanning a tag": "!"}.get(context or "")
+    if problem == "mapping keys are not allowed here":
+        char = "?"
+    if char is not None:
+        shown = "`` ` ``" if char == "`" else f"`{char}`"
+        return (f"{shown} cannot start a value in YAML",
+                'the value in quotes: "?"' if char == "?" else f'the value in quotes: "{char}..."')
+    if context == "while scanning a block scalar":
+        return ("after `|` or `>` (a block of text) only `+`, `-` or a digit from 1 to 9 may "
+                "follow on its line", "the text on the lines below, indented, or the value in "
+                "quotes")
+    return _TOKEN_NAMES.sub(lambda m: _TOKENS[m.group(0)], problem), None
+
+
+#: PyYAML's names of its tokens, in words (for its messages not said otherwise above)
+_TOKENS = {"'<stream end>'": "the end of the file", "'<scalar>'": "a value",
+           "'<tag>'": "a tag (`!`)", "'<anchor>'": "an anchor (`&`)", "'<alias>'": "an alias (`*`)",
+           "'<block mapping start>'": "a key", "'<block sequence start>'": "a `- ` item",
+           "'<block end>'": "less indentation", "<block end>": "less indentation",
+           "'<flow sequence start>'": "`[`", "'<flow mapping start>'": "`{`",
+           "'<document start>'": "`---`", "'<document end>'": "`...`",
+           "'<directive>'": "a `%` directive"}
+_TOKEN_NAMES = re.compile("|".join(re.escape(t) for t in sorted(_TOKENS, key=len, reverse=True)))
 
 
 def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],

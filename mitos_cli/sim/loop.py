@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from ..errors import CommandError, InputError, WorldError
+from ..numbers import whole_number
 from ..words import clearance as shown_clearance
 from ..words import plural
 from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors
@@ -178,7 +179,16 @@ class SimResult:
     _true: dict | None = field(default=None, repr=False)
 
     def route_at(self, k: int, i: int) -> Route:
-        """The route robot ``i`` followed at tick ``k`` (its last replan up to then)."""
+        """The route robot ``i`` followed at tick ``k`` (its last replan up to then); a tick or
+        a robot the run does not have is an :class:`InputError` (a tick past the end gave the
+        last route without a word, and a robot past the last an ``IndexError``)."""
+        robots = len(self.routes)
+        if (j := whole_number(i)) is None or not 0 <= j < robots:
+            raise InputError(f"i is the index of one of the run's {plural(robots, 'robot')}, "
+                             f"0 to {robots - 1}, not `{i!r:.40}`")
+        if (tick := whole_number(k)) is None or not 0 <= tick < self.ticks:
+            raise InputError(f"k is a tick of the run, 0 to {self.ticks - 1}, not `{k!r:.40}`")
+        k, i = tick, j
         route = self.routes[i]
         for tick, j, r in self.replanned:
             if j == i and tick <= k:
@@ -204,7 +214,14 @@ class SimResult:
                 f"after {m.get('time_s', self.ticks * self.world.dt):g} s ({plural(self.ticks, 'tick')}"
                 f"{f', {robots} robots' if robots > 1 else ''}), path "
                 f"{m.get('path_length_in', 0.0):.1f} in, min clearance "
-                f"{shown_clearance(m.get('min_clearance_in', 0.0))} in>")
+                f"{self.shown_clearance()} in>")
+
+    def shown_clearance(self) -> str:
+        """The run's least clearance as the verdict of ``mitos simulate`` prints it: to a
+        tenth, with as many more digits as it takes to show which side of the robots' least
+        safety margin it lies on (1.99 beside 2 is ``1.99``, not ``2.0``)."""
+        margin = min((a.robot.safety_margin for a in self.world.agents), default=None)
+        return shown_clearance(self.metrics.get("min_clearance_in", 0.0), margin)
 
     def _repr_png_(self) -> bytes | None:
         """A notebook shows the run as ``--plot`` draws it (nothing without matplotlib)."""

@@ -990,12 +990,15 @@ def _units_hint(world: World, agent: Agent) -> str | None:
         return None
     w = min(narrow)
     return (f"lengths in a world are inches: a corridor `width: {w:g}` is narrower than the "
-            f"robot ({agent.robot.width:g} in wide){_as_metres(w)}")
+            f"robot ({agent.robot.width:g} in wide){_as_metres(w, agent.robot.width)}")
 
 
-def _as_metres(x: float) -> str:
-    """``; if 1.8 is metres, write 71`` for a length that reads as metres, else nothing."""
-    return f"; if {x:g} is metres, write {x / 0.0254:.0f}" if x < 20 else ""
+def _as_metres(x: float, need: float) -> str:
+    """``; if 1.8 is metres, write 71`` for a length that reads as metres and, so read, is at
+    least ``need`` inches, else nothing (`width: 0.3` was told "write 12", still narrower than
+    the robot, and `width: 0.001` "write 0", which the reader refuses)."""
+    inches = f"{x / 0.0254:.0f}"
+    return f"; if {x:g} is metres, write {inches}" if x < 20 and float(inches) >= need else ""
 
 
 def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
@@ -1397,6 +1400,10 @@ def resolve_world_path(name: str | Path, base: Path | None = None) -> Path:
     if found is not None:
         return found
     where = Path(name) if base is None else base / name
+    if str(name) == "-":            # as `eval --batch -` and `teach --lesson -` read stdin
+        raise UnknownWorld("a world is read from its file, not from standard input (`-`)",
+                           hint="save it to a file and name that (a map it names is found "
+                                "beside the world's file)")
     if is_dir(where):
         raise UnknownWorld(f"`{name}` is a directory, not a world file",
                            hint="name one of the world files (.yaml) in it")
