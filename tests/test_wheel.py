@@ -38,7 +38,7 @@ def test_installed_wheel_carries_grammar_and_rulebases(tmp_path):
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation",
                     "-q", "-w", str(dist), str(ROOT)], check=True, capture_output=True,
                    timeout=300)
-    (wheel,) = dist.glob("mitos-*.whl")
+    (wheel,) = dist.glob("mitos_planner-*.whl")      # the distribution mitos-planner
     site = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
                     str(site), str(wheel)], check=True, capture_output=True, timeout=300)

@@ -292,10 +292,11 @@ def _check_unset(variables: list[_Var], rules: list[Rule], settings: Settings) -
                           hint="add `implication: Minimum` (or another T-norm) to the "
                                "RuleBlock")
     first: dict[str, Rule] = {}
+    by_name = {v.name: v for v in variables}          # (a search per rule was quadratic)
+    keys = {v.name: {entry[0] for entry in v.record} for v in variables}
     for rule in rules:
         for c in rule.consequents:
-            v = next(x for x in variables if x.name == c.var)
-            written = {entry[0] for entry in v.record}
+            v, written = by_name[c.var], keys[c.var]
             if "defuzzify" not in written:
                 raise FormatError(f"output `{c.var}` has no defuzzifier, but rule {rule.label} "
                                   f"sets it: fuzzylite stops without one", span=v.span,
