@@ -59,7 +59,7 @@ def bench_distributions() -> set[str]:
         seen.add(extra)
         for requirement in extras[extra]:
             name, wanted = project_name(requirement)
-            if name == "mitos":
+            if name == project_name(project["name"])[0]:      # the extras it names of itself
                 todo += [e for e in wanted if e not in seen]
             else:
                 names.add(name)

@@ -326,7 +326,7 @@ def test_without_pillow_a_png_is_refused_with_what_to_install(tmp_path, monkeypa
 
     (tmp_path / "m.png").write_bytes(b"\x89PNG\r\n\x1a\n")
     monkeypatch.setitem(sys.modules, "PIL", None)
-    with pytest.raises(WorldError, match=r"needs Pillow: pip install 'mitos\[maps\]'") as exc:
+    with pytest.raises(WorldError, match=r"needs Pillow: pip install 'Pillow>=9' \(the `maps` extra") as exc:
         load_map_yaml(_map(tmp_path, "m.png"))
     assert exc.value.span.line == 1
 
