@@ -445,11 +445,15 @@ def _command(action: object) -> np.ndarray:
     """``action`` as the ``[1, 2]`` command it is, else a :class:`CommandError` saying what an
     action is (``step(5)`` met NumPy's "cannot reshape array of size 1 into shape (1,2)"; a
     bool was read as 1 or 0, where every other entry point refuses it)."""
-    from .engine.inputs import holds_bool
+    from .engine.inputs import holds_bool, holds_text
 
     if holds_bool(action):
         raise CommandError(f"the action must be numbers, not bools: `{action!r:.80}`",
                            hint="give numbers: True and False would be read as 1 and 0")
+    if holds_text(action):
+        raise CommandError(f"the action must be numbers, not text: `{action!r:.80}`",
+                           hint="give numbers: NumPy reads text as Python's float() does, "
+                                "`'5_0'` as 50")
     try:
         command = np.asarray(action, dtype=np.float64)
     except OverflowError:               # (an int past a float's range: 10**400)
@@ -466,6 +470,7 @@ def _command(action: object) -> np.ndarray:
     if not np.isfinite(command).all():
         raise CommandError(f"the action must be finite numbers, not {action!r:.80}")
     return command.reshape(1, 2)
+
 
 
 def env_name(world_file: str) -> str:

@@ -269,11 +269,24 @@ def test_reset_reports_where_the_robot_stands(short_world):
     assert all(state["inputs"][k][0] == ref.perceived[k][0, 0] for k in ref.perceived)
 
 
+@pytest.mark.parametrize("action", ["go", ["90", 20], ("5_0", 10.0), np.array(["90", "20"]),
+                                    np.array([90.0, "20"], dtype=object)])
+def test_an_action_holding_text_is_refused(action):
+    """``step(["90", 20])`` steered at 90 deg and ``("5_0", 10)`` at 50: NumPy reads text as
+    ``float()`` does. Text is refused, as bools are, and the episode is left as it was."""
+    from mitos_cli.errors import CommandError
+
+    env = gymnasium.make("mitos/Corridor-v0")
+    env.reset(seed=1)
+    with pytest.raises(CommandError, match="the action must be numbers, not text"):
+        env.step(action)
+    assert env.unwrapped.sim.ticks == 0
+
+
 @pytest.mark.parametrize("action, says", [
     (5.0, "not `5.0`"),
     (None, "not `None`"),
     ([90.0, 10.0, 1.0], "not of shape (3,)"),
-    ("go", "not `'go'`"),
 ])
 def test_an_action_that_is_not_steering_and_speed_says_what_an_action_is(action, says):
     """step(5) met NumPy's "cannot reshape array of size 1 into shape (1,2)", step("go") its

@@ -460,14 +460,26 @@ def test_the_spread_of_one_run_is_none_not_zero():
     assert one.figures()["time_s"] == {"mean": 0.2, "std": None}
 
 
+@pytest.mark.parametrize("command", ["fast", [["90", 20.0]], [("5_0", 10.0)],
+                                     np.array([["90", "20"]])])
+def test_a_command_holding_text_is_refused(command):
+    """``step([["90", 20]])`` steered at 90 deg and ``[("5_0", 10)]`` at 50: NumPy reads
+    text as ``float()`` does. Text is refused, as bools are, and the run is left as it was."""
+    from mitos_cli.errors import CommandError
+
+    sim = Simulation(short("corridor.yaml", 1.0))
+    with pytest.raises(CommandError, match="the command must be numbers, not text"):
+        sim.step(command)
+    assert sim.ticks == 0
+
+
 @pytest.mark.parametrize("command, says", [
-    ("fast", "not `'fast'`"),
     (5.0, "not `5.0`"),                 # (None is no command: the planner drives)
     (np.zeros((2, 2)), "not of shape (2, 2)"),
 ])
 def test_a_command_that_is_not_numbers_is_a_command_error(command, says):
-    """step("fast") met NumPy's "could not convert string to float"; the shape and NaN
-    messages were ValueErrors outside the project's errors (they are still ValueErrors)."""
+    """step(5.0) met NumPy's "cannot reshape"; the shape and NaN messages were ValueErrors
+    outside the project's errors (they are still ValueErrors)."""
     from mitos_cli.errors import CommandError
 
     sim = Simulation(short("corridor.yaml", 1.0))

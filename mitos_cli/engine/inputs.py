@@ -169,6 +169,18 @@ def holds_bool(value: object) -> bool:
     return isinstance(value, (list, tuple)) and _holds_bool(value)
 
 
+def holds_text(value: object) -> bool:
+    """Whether ``value`` is text, or a list, tuple or array holding some (``["90", 20]``):
+    what NumPy reads as numbers as Python's ``float()`` does (``"5_0"`` as 50) where numbers
+    were given (a robot's command, say)."""
+    if isinstance(value, (list, tuple)):
+        return any(holds_text(v) for v in value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind in "US" or (value.dtype == object
+                                            and any(holds_text(v) for v in value.flat))
+    return isinstance(value, (str, bytes, np.str_, np.bytes_))
+
+
 def _holds_bool(values: list | tuple) -> bool:
     """Whether a list or tuple, or one nested in it, holds a bool (NumPy reads a bool among
     numbers as 1 or 0, and says nothing). By the set of types: 20 ms for a million floats."""

@@ -819,13 +819,17 @@ class Simulation:
 
     def _command(self, command: object) -> np.ndarray:
         """A command given from outside as ``[n, 2]`` finite floats, else a
-        :class:`CommandError` (text or ``None`` met NumPy's conversion errors; a bool was
-        read as 1 or 0)."""
-        from ..engine.inputs import holds_bool
+        :class:`CommandError` (``None`` met NumPy's conversion errors; a bool was read as 1
+        or 0, and text as ``float()`` reads it, ``"5_0"`` as 50)."""
+        from ..engine.inputs import holds_bool, holds_text
 
         if holds_bool(command):
             raise CommandError(f"the command must be numbers, not bools: `{command!r:.80}`",
                                hint="give numbers: True and False would be read as 1 and 0")
+        if holds_text(command):
+            raise CommandError(f"the command must be numbers, not text: `{command!r:.80}`",
+                               hint="give numbers: NumPy reads text as Python's float() does, "
+                                    "`'5_0'` as 50")
         try:
             given = np.asarray(command, float)
         except OverflowError:           # (an int past a float's range: 10**400)
