@@ -902,6 +902,25 @@ def test_an_obstacle_inside_a_wall_is_a_warning_not_an_error():
     assert parse_world(BASE, "w.yaml").notes == ()
 
 
+def test_a_mover_that_goes_into_a_wall_is_a_warning_and_one_that_comes_out_is_not():
+    """A mover passes through walls in the simulator (a cart whose waypoints crossed an
+    office's walls drove through two, without a word); one that starts in a wall, as out of
+    a doorway, and comes into the corridor is meant."""
+    into = parse_world(BASE + "obstacles:\n  - {name: cart, shape: circle, at: [100, 0], "
+                       "radius: 5, velocity: [0, 10]}\n", "w.yaml")
+    assert into.notes == ("w.yaml:16:5: obstacle `cart` moves into a wall at (100, 36) after "
+                          "3.6 s: a mover passes through walls here, where a real one would "
+                          "stop (check its `waypoints` or `velocity`)",)
+    out = parse_world(BASE + "obstacles:\n  - {name: door, shape: circle, at: [100, 60], "
+                      "radius: 5, waypoints: [[100, 60], [100, 0]], speed: 10, mode: stop}\n",
+                      "w.yaml")
+    assert out.notes == ()
+    along = parse_world(BASE + "obstacles:\n  - {name: cart, shape: circle, at: [100, 0], "
+                        "radius: 5, waypoints: [[100, 0], [350, 0]], speed: 10, "
+                        "mode: ping-pong}\n", "w.yaml")
+    assert along.notes == ()
+
+
 def test_a_randomise_range_that_buries_an_obstacle_is_a_warning():
     w = parse_world(BASE + OBSTACLES + "randomise:\n  obstacles:\n    box: {dy: [-100, 100]}\n",
                     "w.yaml")

@@ -1013,8 +1013,14 @@ def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
     jitters = {j.obstacle: j for j in world.randomise.obstacles}
     moves: YMap | None = top["randomise"].get("obstacles") if "randomise" in top else None
     for i, o in enumerate(world.obstacles):
-        if o.motion.kind != "static":
-            continue                            # a mover may be meant to come out of one
+        if o.motion.kind != "static":           # it may come out of one (a doorway), but
+            into = _moves_into_wall(static, o, world.time_limit)   # not go into one
+            if into is not None:
+                notes.append(f"{written.item_span(i)}: obstacle `{o.name}` moves into a wall "
+                             f"at ({into[1]:g}, {into[2]:g}) after {into[0]:g} s: a mover "
+                             "passes through walls here, where a real one would stop (check "
+                             "its `waypoints` or `velocity`)")
+            continue
         if _inside_wall(static, o, (o.x, o.y)):
             notes.append(f"{written.item_span(i)}: obstacle `{o.name}` at ({o.x:g}, {o.y:g}) "
                          "lies entirely inside a wall: no beam or robot can reach it (move "
@@ -1027,6 +1033,30 @@ def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
                              f"puts it at ({o.x + off[0]:g}, {o.y + off[1]:g})): those runs "
                              "have no such obstacle (narrow its dx and dy)")
     return notes
+
+
+def _moves_into_wall(static: StaticMap, o: Obstacle, limit: float
+                     ) -> tuple[float, float, float] | None:
+    """When and where (``t, x, y``, rounded to 0.1) the centre of the moving obstacle ``o``
+    first passes from free space into a wall within ``limit`` seconds, looked at every inch
+    of its way (every 0.1 s where it moves slower), or None."""
+    import numpy as np
+
+    from .obstacles import position
+
+    m = o.motion
+    speed = float(np.hypot(*m.velocity)) if m.kind == "velocity" else m.speed
+    if speed <= 0 or limit <= 0:
+        return None
+    step = min(0.1, 1.0 / speed)
+    times = np.arange(int(min(limit, 3600.0) / step) + 1) * step    # (an hour of its way)
+    at = np.array([position(o, float(t)) for t in times])
+    free = static.free(at)
+    into = np.flatnonzero(free[:-1] & ~free[1:])
+    if not len(into):
+        return None
+    k = int(into[0]) + 1
+    return round(float(times[k]), 1), round(float(at[k, 0]), 1), round(float(at[k, 1]), 1)
 
 
 def _walled_offset(static: StaticMap, o: Obstacle, j: Jitter) -> tuple[float, float] | None:
