@@ -195,8 +195,11 @@ def test_not_adapted_names_frozen_input_terms_frozen_rules_terms_and_frozen_outp
 
 def test_refusals_are_clear():
     # (Mamdani behaviors are adapted too: tests/test_teach_mamdani.py)
-    with pytest.raises(LessonError, match="not `and = lukasiewicz`"):
+    with pytest.raises(LessonError, match="not `and = lukasiewicz`") as exc:
         parameterise(small("operators: and = lukasiewicz\n" + RULES))
+    assert exc.value.message == ("adaptation has gradients for `and = min / product`, not "
+                                 "`and = lukasiewicz`")
+    assert exc.value.hint == "adapt with one of those (`and = min` is the paper's)"
     compiled = small()
     with pytest.raises(LessonError, match=r"\(0, 1\)"):
         adapt(compiled, points(5), np.zeros((5, 1)), rate=1.5)

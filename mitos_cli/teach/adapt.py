@@ -342,7 +342,8 @@ def _supported(compiled: CompiledRuleBase) -> None:
         if norm.gradient is None:
             raise LessonError(f"adaptation has gradients for `{op} = "
                               f"{' / '.join(names)}`, not `{op} = {norm.name}`",
-                              hint="adapt with the paper's min / max operators")
+                              hint=f"adapt with one of those (`{op} = {names[0]}` is the "
+                                   f"paper's)")
 
 
 @dataclass
