@@ -178,6 +178,9 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
 @pytest.mark.parametrize("args, code, words", [
     (["worlds/corridr.yaml"], 1, "did you mean `worlds/corridor.yaml`"),
     (["TINY", "--and", "einstien"], 2, "unknown T-norm `einstien`"),
+    # the unbounded sum is no S-norm: a name `--or` does not take, as `--and sum` (was exit 1)
+    (["TINY", "--or", "sum"], 2, "the unbounded sum is a Mamdani aggregation only"),
+    (["TINY", "--or", "max,unbounded_sum"], 2, "did you mean `bounded_sum`"),
     (["TINY", "--planner", "potential"], 2, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
     (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
