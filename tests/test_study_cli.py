@@ -573,3 +573,19 @@ def test_a_study_that_named_a_packaged_world_by_its_path_resumes_by_its_name(tmp
     assert r.exit_code == 0, r.output
     assert "1 run now, 1 from before" in r.stderr
     assert [row["world"] for row in read_rows("s")] == [path, path]
+
+
+def test_a_rule_base_without_the_worlds_behavior_says_how_to_choose_one(tiny, tmp_path,
+                                                                        compare):
+    """`mitos compare tiny.yaml -r tipper.fis` said "unknown behavior `drive`, expected one of
+    main" with no position and no word of why `drive` was looked for, nor how to choose
+    another, which `mitos simulate` says."""
+    tipper = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    r = compare(tiny, "--planner", "fuzzy", "-r", tipper, "--runs", 1, "-o", tmp_path / "s")
+    assert r.exit_code == 1 and "unknown behavior `drive`" in r.stderr, r.output
+    lines = r.stderr.splitlines()
+    assert lines[0].startswith(f"{tiny}:") and lines[1].strip() == "behavior: drive", r.stderr
+    assert lines[-1] == (
+        "hint: the world is driven by its `behavior: drive`, which this rule base lacks: "
+        "choose one of its behaviors (--behavior NAME; behavior= from Python)")
+    assert not (tmp_path / "s" / "results.csv").exists()
