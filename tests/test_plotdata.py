@@ -360,3 +360,44 @@ def test_the_data_of_the_pictures_take_what_load_rulebase_returns():
                       (lambda: rule_view(None, values), "rule_view")):
         with pytest.raises(InputError, match=f"{who} draws a compiled rule base, not "):
             call()
+
+
+TSUKAMOTO_TERMS = """\
+variables:
+  x:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: left_shoulder, points: [2, 8]}
+      HI: {shape: right_shoulder, points: [2, 8]}
+  y:
+    role: output
+    universe: [0, 100]
+    terms:
+      UP: {shape: ramp, start: 0, end: 100}
+      DOWN: {shape: ramp, start: 100, end: 0}
+"""
+
+
+def test_rule_view_tsukamoto_stems_stand_where_the_engine_inverts_the_terms(tmp_path):
+    """Under Tsukamoto inference the viewer drew each consequent at its term's centre (UP at
+    100, DOWN at 0) with the rule's DOF, so the stems' weighted mean was not the
+    result the viewer printed over them: each term stands where it is inverted at its
+    summed (and hedged) degree, z = mu^-1(w), as the engine averages it."""
+    (tmp_path / "t.terms.yaml").write_text(TSUKAMOTO_TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+        "r1: if x is LO then y is UP\nr2: if x is HI then y is somewhat DOWN\n",
+        encoding="utf-8")
+    view = plotdata.rule_view(load_rulebase(tmp_path / "t.rules").compiled, {"x": 4.4})
+    lo, hi = 0.6, 0.4                                    # LO and HI at x = 4.4
+    w_up, w_down = lo, hi ** 0.5                         # r1; somewhat(r2)
+    out = view.outputs[0]
+    np.testing.assert_allclose(np.array(out.stems),
+                               [[100 - 100 * w_down, w_down], [100 * w_up, w_up]], rtol=1e-12)
+    values = np.array([v for v, _ in out.stems])
+    weights = np.array([w for _, w in out.stems])
+    assert (values * weights).sum() / weights.sum() == pytest.approx(out.value, rel=1e-12)
+    assert [(r.label, c.term, c.value) for r in view.rows for c in r.consequents] == \
+        [("r1", "UP", pytest.approx(100 * w_up)),
+         ("r2", "DOWN", pytest.approx(100 - 100 * w_down))]

@@ -195,6 +195,8 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
         crisp = linear_consequents(compiled, np.ascontiguousarray(res.inputs.T))[:, :, 0].T
     mamdani = compiled.operators.inference == "mamdani"
     sets = _mamdani_sets(compiled, dof) if mamdani else None
+    if compiled.operators.inference == "tsukamoto":
+        crisp = _tsukamoto_points(compiled, dof, crisp)
 
     fired = np.flatnonzero(dof > 0)
     rows = []
@@ -228,6 +230,31 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
                                   stems, grid, agg, declares_nan(compiled, name)))
     return RuleView(compiled.behavior, compiled.describe_operators(), compiled.n_rules,
                     tuple(inputs), tuple(rows), tuple(outputs))
+
+
+def _tsukamoto_points(compiled: CompiledRuleBase, dof: np.ndarray,
+                      crisp: np.ndarray) -> np.ndarray:
+    """``crisp`` with each rule's consequent where Tsukamoto inference puts it: its term
+    inverted at the term's activation, the summed (hedged) DOFs of the rules concluding it
+    (:mod:`mitos_cli.engine.tsukamoto`), not at the term's centre."""
+    from ...fuzzy.shapes import TSUKAMOTO
+
+    points = np.array(crisp, dtype=float)
+    for j, name in enumerate(compiled.outputs):
+        var = compiled.variables[name]
+        concluding: dict[str, list[int]] = {}
+        for r in range(compiled.n_rules):
+            term = compiled.cons_term[r][j]
+            if term is not None:
+                concluding.setdefault(term, []).append(r)
+        for term, rules in concluding.items():
+            w = sum(float(weigh(compiled.cons_hedges[r][j], np.asarray(dof[r])))
+                    if compiled.cons_hedges[r][j] else float(dof[r]) for r in rules)
+            if w > 0:
+                t = var.term(term)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    points[rules, j] = float(TSUKAMOTO[t.shape](np.asarray(w), *t.params))
+    return points
 
 
 def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.ndarray,
