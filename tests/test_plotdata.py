@@ -401,3 +401,26 @@ def test_rule_view_tsukamoto_stems_stand_where_the_engine_inverts_the_terms(tmp_
     assert [(r.label, c.term, c.value) for r in view.rows for c in r.consequents] == \
         [("r1", "UP", pytest.approx(100 * w_up)),
          ("r2", "DOWN", pytest.approx(100 - 100 * w_down))]
+
+
+@pytest.mark.parametrize("accumulation", ["max", "probabilistic_sum"])
+def test_rule_view_stems_join_one_values_rules_by_the_accumulation(tmp_path, accumulation):
+    """With `accumulation = max` the engine weighs a value by the S-norm of its rules' DOFs
+    (jFuzzyLogic's ACCU); the viewer summed them (value 10 at 1.47 where the engine weighs
+    0.8), so its stems did not average to the result drawn over them."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      MID: {shape: triangle, peak: 5, width: 5}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y: {role: output, universe: [0, 100], terms: {A: 10, B: 90}}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        f'terms "t.terms.yaml"\noperators: accumulation = {accumulation}\n'
+        "r1: if x is LO then y is A\nr2: if x is MID then y is A\nr3: if x is HI then y is B\n",
+        encoding="utf-8")
+    view = plotdata.rule_view(load_rulebase(tmp_path / "t.rules").compiled, {"x": 4})
+    lo, mid, hi = 2 / 3, 0.8, 1 / 3
+    joined = max(lo, mid) if accumulation == "max" else lo + mid - lo * mid
+    out = view.outputs[0]
+    np.testing.assert_allclose(np.array(out.stems), [[10, joined], [90, hi]], rtol=1e-12)
+    assert (10 * joined + 90 * hi) / (joined + hi) == pytest.approx(out.value, rel=1e-12)

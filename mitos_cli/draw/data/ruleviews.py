@@ -260,12 +260,24 @@ def _tsukamoto_points(compiled: CompiledRuleBase, dof: np.ndarray,
 def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.ndarray,
             dof: np.ndarray) -> tuple[tuple[float, float], ...]:
     """Output ``j``'s consequent values with the summed weights the engine averages them by: a
-    hedged consequent's is ``hedge(dof)`` (``very`` squares it), not the rule's DOF."""
+    hedged consequent's is ``hedge(dof)`` (``very`` squares it), not the rule's DOF; under
+    ``accumulation = S`` (an S-norm) the rules of one value are joined by S in rule order,
+    not summed (:func:`mitos_cli.engine.evaluation`'s accumulated inference)."""
+    from ...fuzzy import norms
+
+    accumulation = compiled.operators.accumulation
+    join = None if accumulation == "sum" else norms.lookup("snorm", accumulation)
     summed: dict[float, float] = {}
     for r in rules.tolist():
         hedges = compiled.cons_hedges[r][j]
         w = float(weigh(hedges, np.asarray(dof[r]))) if hedges else float(dof[r])
-        summed[float(crisp[r, j])] = summed.get(float(crisp[r, j]), 0.0) + w
+        value = float(crisp[r, j])
+        if value not in summed:
+            summed[value] = w
+        elif join is None:
+            summed[value] += w
+        else:
+            summed[value] = float(join(np.asarray(summed[value]), np.asarray(w)))
     return tuple(sorted(summed.items()))
 
 
