@@ -424,3 +424,23 @@ def test_rule_view_stems_join_one_values_rules_by_the_accumulation(tmp_path, acc
     out = view.outputs[0]
     np.testing.assert_allclose(np.array(out.stems), [[10, joined], [90, hi]], rtol=1e-12)
     assert (10 * joined + 90 * hi) / (joined + hi) == pytest.approx(out.value, rel=1e-12)
+
+
+def test_surface_says_where_the_output_is_infinite(tmp_path):
+    """A Tsukamoto sigmoid inverted where its rule fires fully makes the output infinite (as
+    in fuzzylite): matplotlib leaves those points out of the curve or surface, and the picture
+    had a gap with no word of why (the terminal table says `inf`)."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y:\n    role: output\n    universe: [0, 100]\n    terms:\n"
+        "      S: {shape: sigmoid, inflection: 50, slope: 0.1}\n"
+        "      DOWN: {shape: ramp, start: 100, end: 0}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+        "r1: if x is LO then y is S\nr2: if x is HI then y is DOWN\n", encoding="utf-8")
+    rb = load_rulebase(tmp_path / "t.rules")
+    s = plotdata.surface(rb.compiled, "y", "x", resolution=11)
+    assert np.isinf(s.z).sum() == 3                       # x = 0, 1, 2: LO fires fully
+    assert "`y` is infinite at 3 of 11 grid points (a picture leaves them out)" in " ".join(s.notes())
