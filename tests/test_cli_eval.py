@@ -755,6 +755,20 @@ def test_a_semicolon_or_tab_separated_file_is_named_as_such(sep, name):
     assert str(info.value.span) == "s.csv:1:1"
 
 
+@pytest.mark.parametrize("line", ["sep=,", "sep=;", "SEP=,", '"sep=,"'])
+def test_excels_separator_line_is_named_as_such(line):
+    """A CSV saved by Excel may start with `sep=,`, the separator for Excel: the header was
+    that line, "no column for road, size, position" (`sep=;` asked whether the separator is
+    `;`), with no word of the line to delete."""
+    text = line + "\nroad,size,position\n78,45,4\n"
+    with pytest.raises(InputError) as info:
+        read_batch(text, "x.csv", ("road", "size", "position"))
+    assert info.value.message == "the batch CSV starts with Excel's separator line, not a header"
+    assert str(info.value.span) == "x.csv:1:1"
+    assert info.value.hint == ("delete the first line (`sep=...`), so that the header naming "
+                               "road, size, position comes first")
+
+
 def test_every_misspelt_column_is_named():
     with pytest.raises(InputError) as info:
         read_batch("road,sise,positon\n78,45,4\n", "m.csv", ("road", "size", "position"))

@@ -145,6 +145,20 @@ def caret_under(exc: MitosError) -> str:
      "`FAR WIDE`: a term's name is one word (`FAR_WIDE`), and `FAR` is not a hedge"),
     ('r1: if road is sorta WIDE then speed is SLOW', 22, 'WIDE', 'unexpected `WIDE`', '`then`',
      '`sorta` is not a hedge (very, extremely, somewhat'),
+    # `is` glued to the next word: it was read as `is` and the rest (`isWIDE` as `is WIDE`,
+    # `iss WIDE` as the term `s`, the error at `WIDE` with a hint about `and` / `or`)
+    ('r1: if road isWIDE then speed is SLOW', 13, 'isWIDE', 'unexpected `isWIDE`', '`is`',
+     '`is` and `WIDE` are two words: `road is WIDE`'),
+    ('r1: if road is WIDE then speed isSLOW', 32, 'isSLOW', 'unexpected `isSLOW`', '`is`',
+     '`is` and `SLOW` are two words: `speed is SLOW`'),
+    ('r1: if road isnot WIDE then speed is SLOW', 13, 'isnot', 'unexpected `isnot`', '`is`',
+     '`is` and `not` are two words: `road is not`'),
+    ('r1: if road is WIDE then steering is90', 35, 'is90', 'unexpected `is90`', '`is`',
+     '`is` and `90` are two words: `steering is 90`'),
+    ('r1: if road iss WIDE then speed is SLOW', 13, 'iss', 'unexpected `iss`', '`is`',
+     'did you mean `is`?'),
+    ('r1: if (road is WIDE) and size isvery SMALL_SZ then speed is SLOW', 32, 'isvery',
+     'unexpected `isvery`', '`is`', '`is` and `very` are two words: `size is very`'),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)

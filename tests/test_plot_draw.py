@@ -114,6 +114,34 @@ def test_masked_surface_says_so(tmp_path):
         "no rule fires (no default)"
 
 
+def test_an_infinite_output_is_not_called_no_rule_fires(tmp_path):
+    """A Tsukamoto sigmoid inverted where its rule fires fully makes the output infinite:
+    the heat map hatched those cells with the legend "no rule fires (no default)", where a
+    rule fires fully, and the curve left a gap with no legend at all."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y: {role: input, universe: [0, 10], terms: {ANY: {shape: rectangle, points: [0, 10]}}}\n"
+        "  out:\n    role: output\n    universe: [0, 100]\n    terms:\n"
+        "      S: {shape: sigmoid, inflection: 50, slope: 0.1}\n"
+        "      DOWN: {shape: ramp, start: 100, end: 0}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+        "r1: if x is LO and y is ANY then out is S\nr2: if x is HI then out is DOWN\n",
+        encoding="utf-8")
+    rb = load_rulebase(tmp_path / "t.rules")
+    s = plotdata.surface(rb.compiled, "out", "x", "y", resolution=11)
+    assert np.isinf(s.z).any() and not np.isnan(s.z).any()
+    fig = draw_surface(s, style="heatmap")
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["`out` infinite"]
+    curve = plotdata.surface(rb.compiled, "out", "x", None, {"y": 5}, resolution=11)
+    fig = draw_surface(curve)
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()][-1] == \
+        "`out` infinite"
+    assert len(by_gid(fig, "no-rule")) == 1
+
+
 def by_gid(fig, gid):
     return [a for ax in fig.axes for a in ax.get_children() if a.get_gid() == gid]
 

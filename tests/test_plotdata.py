@@ -360,3 +360,87 @@ def test_the_data_of_the_pictures_take_what_load_rulebase_returns():
                       (lambda: rule_view(None, values), "rule_view")):
         with pytest.raises(InputError, match=f"{who} draws a compiled rule base, not "):
             call()
+
+
+TSUKAMOTO_TERMS = """\
+variables:
+  x:
+    role: input
+    universe: [0, 10]
+    terms:
+      LO: {shape: left_shoulder, points: [2, 8]}
+      HI: {shape: right_shoulder, points: [2, 8]}
+  y:
+    role: output
+    universe: [0, 100]
+    terms:
+      UP: {shape: ramp, start: 0, end: 100}
+      DOWN: {shape: ramp, start: 100, end: 0}
+"""
+
+
+def test_rule_view_tsukamoto_stems_stand_where_the_engine_inverts_the_terms(tmp_path):
+    """Under Tsukamoto inference the viewer drew each consequent at its term's centre (UP at
+    100, DOWN at 0) with the rule's DOF, so the stems' weighted mean was not the
+    result the viewer printed over them: each term stands where it is inverted at its
+    summed (and hedged) degree, z = mu^-1(w), as the engine averages it."""
+    (tmp_path / "t.terms.yaml").write_text(TSUKAMOTO_TERMS, encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+        "r1: if x is LO then y is UP\nr2: if x is HI then y is somewhat DOWN\n",
+        encoding="utf-8")
+    view = plotdata.rule_view(load_rulebase(tmp_path / "t.rules").compiled, {"x": 4.4})
+    lo, hi = 0.6, 0.4                                    # LO and HI at x = 4.4
+    w_up, w_down = lo, hi ** 0.5                         # r1; somewhat(r2)
+    out = view.outputs[0]
+    np.testing.assert_allclose(np.array(out.stems),
+                               [[100 - 100 * w_down, w_down], [100 * w_up, w_up]], rtol=1e-12)
+    values = np.array([v for v, _ in out.stems])
+    weights = np.array([w for _, w in out.stems])
+    assert (values * weights).sum() / weights.sum() == pytest.approx(out.value, rel=1e-12)
+    assert [(r.label, c.term, c.value) for r in view.rows for c in r.consequents] == \
+        [("r1", "UP", pytest.approx(100 * w_up)),
+         ("r2", "DOWN", pytest.approx(100 - 100 * w_down))]
+
+
+@pytest.mark.parametrize("accumulation", ["max", "probabilistic_sum"])
+def test_rule_view_stems_join_one_values_rules_by_the_accumulation(tmp_path, accumulation):
+    """With `accumulation = max` the engine weighs a value by the S-norm of its rules' DOFs
+    (jFuzzyLogic's ACCU); the viewer summed them (value 10 at 1.47 where the engine weighs
+    0.8), so its stems did not average to the result drawn over them."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      MID: {shape: triangle, peak: 5, width: 5}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y: {role: output, universe: [0, 100], terms: {A: 10, B: 90}}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        f'terms "t.terms.yaml"\noperators: accumulation = {accumulation}\n'
+        "r1: if x is LO then y is A\nr2: if x is MID then y is A\nr3: if x is HI then y is B\n",
+        encoding="utf-8")
+    view = plotdata.rule_view(load_rulebase(tmp_path / "t.rules").compiled, {"x": 4})
+    lo, mid, hi = 2 / 3, 0.8, 1 / 3
+    joined = max(lo, mid) if accumulation == "max" else lo + mid - lo * mid
+    out = view.outputs[0]
+    np.testing.assert_allclose(np.array(out.stems), [[10, joined], [90, hi]], rtol=1e-12)
+    assert (10 * joined + 90 * hi) / (joined + hi) == pytest.approx(out.value, rel=1e-12)
+
+
+def test_surface_says_where_the_output_is_infinite(tmp_path):
+    """A Tsukamoto sigmoid inverted where its rule fires fully makes the output infinite (as
+    in fuzzylite): matplotlib leaves those points out of the curve or surface, and the picture
+    had a gap with no word of why (the terminal table says `inf`)."""
+    (tmp_path / "t.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LO: {shape: left_shoulder, points: [2, 8]}\n"
+        "      HI: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y:\n    role: output\n    universe: [0, 100]\n    terms:\n"
+        "      S: {shape: sigmoid, inflection: 50, slope: 0.1}\n"
+        "      DOWN: {shape: ramp, start: 100, end: 0}\n", encoding="utf-8")
+    (tmp_path / "t.rules").write_text(
+        'terms "t.terms.yaml"\noperators: inference = tsukamoto\n'
+        "r1: if x is LO then y is S\nr2: if x is HI then y is DOWN\n", encoding="utf-8")
+    rb = load_rulebase(tmp_path / "t.rules")
+    s = plotdata.surface(rb.compiled, "y", "x", resolution=11)
+    assert np.isinf(s.z).sum() == 3                       # x = 0, 1, 2: LO fires fully
+    assert "`y` is infinite at 3 of 11 grid points (a picture leaves them out)" in " ".join(s.notes())

@@ -178,6 +178,9 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
 @pytest.mark.parametrize("args, code, words", [
     (["worlds/corridr.yaml"], 1, "did you mean `worlds/corridor.yaml`"),
     (["TINY", "--and", "einstien"], 2, "unknown T-norm `einstien`"),
+    # the unbounded sum is no S-norm: a name `--or` does not take, as `--and sum` (was exit 1)
+    (["TINY", "--or", "sum"], 2, "the unbounded sum is a Mamdani aggregation only"),
+    (["TINY", "--or", "max,unbounded_sum"], 2, "did you mean `bounded_sum`"),
     (["TINY", "--planner", "potential"], 2, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
     (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
@@ -570,3 +573,19 @@ def test_a_study_that_named_a_packaged_world_by_its_path_resumes_by_its_name(tmp
     assert r.exit_code == 0, r.output
     assert "1 run now, 1 from before" in r.stderr
     assert [row["world"] for row in read_rows("s")] == [path, path]
+
+
+def test_a_rule_base_without_the_worlds_behavior_says_how_to_choose_one(tiny, tmp_path,
+                                                                        compare):
+    """`mitos compare tiny.yaml -r tipper.fis` said "unknown behavior `drive`, expected one of
+    main" with no position and no word of why `drive` was looked for, nor how to choose
+    another, which `mitos simulate` says."""
+    tipper = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    r = compare(tiny, "--planner", "fuzzy", "-r", tipper, "--runs", 1, "-o", tmp_path / "s")
+    assert r.exit_code == 1 and "unknown behavior `drive`" in r.stderr, r.output
+    lines = r.stderr.splitlines()
+    assert lines[0].startswith(f"{tiny}:") and lines[1].strip() == "behavior: drive", r.stderr
+    assert lines[-1] == (
+        "hint: the world is driven by its `behavior: drive`, which this rule base lacks: "
+        "choose one of its behaviors (--behavior NAME; behavior= from Python)")
+    assert not (tmp_path / "s" / "results.csv").exists()

@@ -36,12 +36,22 @@ def title_of(s: Surface) -> str:
     return text
 
 
+def _masked_words(s: Surface) -> str:
+    """What the blank (masked) points are: where no rule fires (NaN), and where the output
+    is infinite (a Tsukamoto sigmoid inverted at 1), which is no \"no rule fires\"."""
+    said = []
+    if np.isnan(s.z).any():
+        said.append("no rule fires (default nan)" if s.nan_default else
+                    "no rule fires (no default)")
+    if np.isinf(s.z).any():
+        said.append(f"`{s.output}` infinite")
+    return " or ".join(said)
+
+
 def _no_rule_patch(s: Surface) -> Patch:
     from matplotlib.patches import Patch
 
-    return Patch(facecolor="white", edgecolor=HATCH_COLOR, hatch="///",
-                 label="no rule fires (default nan)" if s.nan_default else
-                 "no rule fires (no default)")
+    return Patch(facecolor="white", edgecolor=HATCH_COLOR, hatch="///", label=_masked_words(s))
 
 
 def _nan_spans(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
@@ -64,7 +74,7 @@ def draw_curve(ax: Axes, s: Surface) -> None:
     """One input: the output as a line; spans where nothing fires shaded and hatched."""
     x, z = s.x.values, s.z
     ax.plot(x, z, color="#1f77b4", linewidth=2.2, label=s.output)
-    mask = np.isnan(z)
+    mask = ~np.isfinite(z)
     if mask.any():
         for lo, hi in _nan_spans(x, mask):
             ax.axvspan(lo, hi, facecolor="none", edgecolor=HATCH_COLOR, hatch="///",
@@ -160,9 +170,8 @@ def draw_surface3d(fig: Figure, ax: Axes3D, s: Surface) -> None:
     bar = fig.colorbar(surf, ax=ax, shrink=0.55, pad=0.1)
     bar.set_label(s.label)
     if z.mask.any():
-        ax.text2D(0.0, 0.0, "holes: no rule fires and the output's default is nan"
-                  if s.nan_default else "holes: no rule fires and the output has no default",
-                  transform=ax.transAxes, fontsize=8, color="#555555")
+        ax.text2D(0.0, 0.0, f"holes: {_masked_words(s)}", transform=ax.transAxes, fontsize=8,
+                  color="#555555")
 
 
 def draw_surface(s: Surface, path: str | Path | None = None, *, style: str = "surface",

@@ -196,6 +196,12 @@ def _check_header(header: list[str], text: str, path: str, inputs: tuple[str, ..
     missing = [k for k in inputs if k not in header]
     if not missing:
         return
+    if header and header[0].strip().lower().startswith("sep="):
+        # Excel writes `sep=,` (or `sep=;`) above the header for itself
+        raise InputError("the batch CSV starts with Excel's separator line, not a header",
+                         span=_span(text, path, 0),
+                         hint="delete the first line (`sep=...`), so that the header naming "
+                              + ", ".join(inputs) + " comes first")
     if len(header) == 1:
         for sep, name in ((";", "`;`"), ("\t", "a tab")):
             if sep in header[0]:

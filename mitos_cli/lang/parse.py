@@ -168,6 +168,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     missing = _missing_colon(exc, text, path)
     if missing is not None:
         return missing
+    glued = _GLUED_BEFORE.search(text, 0, token.start_pos or 0)
+    if glued and glued.group(1) not in RESERVED and glued.group(1) not in HEDGE_NAMES:
+        # `road iss WIDE`: read as `road is s`, then "unexpected `WIDE`"
+        return _glued_is_error(text, path, glued.group(1), glued.start(2), glued.end(2), None)
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
     hint = None
@@ -663,7 +667,53 @@ def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree
         raise syntax_error(exc, text, path) from None
     check_nesting(tree, text, path)
     check_modifiers(tree, text, path)
+    check_glued_is(tree, text, path)
     return tree
+
+
+#: `is` at the start of a longer word (`road isWIDE`): where only `is` may follow a variable's
+#: name, the lexer takes the keyword off the front of the word and reads the rest as the next
+#: word (`isWIDE` was `is WIDE`, `iss WIDE` the term `s` and then an error at `WIDE`)
+_GLUED_IS = re.compile(r"(?<![\w-])is\w")
+_GLUED_BEFORE = re.compile(r"(?<![\w-])([A-Za-z_][\w-]*)[ \t]+(is\w[\w-]*)\s*$")
+
+
+def _glued_is_error(text: str, path: str | None, var: str, start: int, end: int,
+                    rest: str | None) -> RuleSyntaxError:
+    """``is`` glued to the word after it, ``text[start:end]``, after the variable ``var``."""
+    word = text[start:end]
+    line = text.count("\n", 0, start) + 1
+    column = start - (text.rfind("\n", 0, start) + 1) + 1
+    hint = (f"`is` and `{rest}` are two words: `{var} is {rest}`" if rest is not None else
+            did_you_mean(word, ["is"]) or f"`{var}` is a variable: write `{var} is TERM`")
+    return RuleSyntaxError(f"unexpected `{word}`",
+                           span=Span.in_text(text, path, line, column, column + len(word)),
+                           expected="`is`", hint=hint)
+
+
+def check_glued_is(tree: Tree, text: str, path: str | None) -> None:
+    """Refuse ``road isWIDE`` (and ``speed is90``, ``road isnot WIDE``), which the lexer
+    read as ``road is WIDE``: `is` is a word of its own, as every keyword is elsewhere."""
+    if _GLUED_IS.search(text) is None:
+        return                            # the usual case: no walk
+    glued = []
+    for node in _subtrees(tree):
+        if node.data not in ("proposition", "term_consequent", "crisp_consequent"):
+            continue
+        var, after = node.children[0], node.children[1]
+        while isinstance(after, Tree):
+            after = after.children[0]
+        if not isinstance(var, Token) or not isinstance(after, Token) \
+                or var.end_pos is None or after.start_pos is None:
+            continue
+        start = after.start_pos - 2
+        if start >= var.end_pos and text[start:after.start_pos] == "is" \
+                and (str(after)[:1].isalnum() or str(after)[:1] == "_"):
+            glued.append((start, var, after))
+    if glued:
+        start, var, after = min(glued, key=lambda g: g[0])
+        raise _glued_is_error(text, path, str(var), start, after.end_pos or start + 2,
+                              str(after))
 
 
 #: what ``then y is not A`` is refused as: (the thing, the hint), or a hint made from its

@@ -200,18 +200,25 @@ def fuzzy_planner(world: World, rulebase: RuleBaseSource = None, behavior: str |
     try:
         return FuzzyPlanner(rulebase, world.behavior if behavior is None else behavior)
     except NameError_ as exc:       # the world file's `behavior:` names none of the rule base's
-        if behavior is not None or exc.span is not None \
-                or not exc.message.startswith("unknown behavior"):
-            raise
-        exc.span = getattr(world, "behavior_span", None)
-        # `simulate figure4 --rulebase tipper.fis`: the error stood at the world's line with
-        # no word of why the world's behavior was looked for, nor how to choose another
-        said = (f"the world is driven by its `behavior: {world.behavior}`, which "
-                f"{'this rule base' if rulebase is not None else 'the rule base'} lacks: "
-                f"choose one of its behaviors (--behavior NAME; behavior= from Python)")
-        exc.hint = (f"{exc.hint} (--behavior NAME drives with another than the world's "
-                    f"`behavior: {world.behavior}`)" if exc.hint else said)
+        if behavior is None:
+            said_at_world(exc, world, rulebase is not None)
         raise
+
+
+def said_at_world(exc: NameError_, world: World, given: bool) -> None:
+    """``exc``, "unknown behavior" for the world's own ``behavior:``, said at the world's line
+    with why it was looked for and how to choose another (``given``: a rule base was given,
+    not the packaged one); any other error is left as it is."""
+    if exc.span is not None or not exc.message.startswith("unknown behavior"):
+        return
+    exc.span = getattr(world, "behavior_span", None)
+    # `simulate figure4 --rulebase tipper.fis`: the error stood at the world's line with
+    # no word of why the world's behavior was looked for, nor how to choose another
+    said = (f"the world is driven by its `behavior: {world.behavior}`, which "
+            f"{'this rule base' if given else 'the rule base'} lacks: "
+            f"choose one of its behaviors (--behavior NAME; behavior= from Python)")
+    exc.hint = (f"{exc.hint} (--behavior NAME drives with another than the world's "
+                f"`behavior: {world.behavior}`)" if exc.hint else said)
 
 
 def _potential_field(world: World, rulebase: RuleBaseSource = None, behavior: str | None = None) -> Planner:

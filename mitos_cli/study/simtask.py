@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..errors import NameError_
 from .spec import Choice, Task
 from .store import RESULT_FIELDS, StudyError
 
@@ -153,14 +154,19 @@ def _planner(context: StudyContext, choice: Choice, path: str) -> Planner:
 @functools.lru_cache(maxsize=64)
 def _make_planner(context: StudyContext, choice: Choice, path: str, key: str | None,
                   rulebase: str | None) -> Planner:
-    from ..sim.planner import make_planner
+    from ..sim.planner import make_planner, said_at_world
 
     world = _world(path, key)
     if choice.planner != "fuzzy":
         return make_planner(choice.planner, world)
     behavior = context.behavior or world.behavior
-    return make_planner("fuzzy", world, loaded_rulebase(context.rulebase, rulebase, behavior,
-                                                        choice.overrides()), behavior)
+    try:
+        compiled = loaded_rulebase(context.rulebase, rulebase, behavior, choice.overrides())
+    except NameError_ as exc:       # the world's `behavior:`, not in the rule base: said there
+        if not context.behavior:
+            said_at_world(exc, world, context.rulebase is not None)
+        raise
+    return make_planner("fuzzy", world, compiled, behavior)
 
 
 def run_task(context: StudyContext, task: Task) -> dict:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, unknown
+from ..errors import InputError, NameError_, unknown
 from ..fuzzy import norms
 from ..lang.operators import INFERENCES
 from ..sim.planner import PLANNERS as _REGISTRY
@@ -91,9 +91,11 @@ def canonical_snorm(name: str, tnorm: str) -> str:
             return ""
         return norms.lookup("tnorm", tnorm).dual
     if name in (norms.UNBOUNDED_SUM.name, *norms.UNBOUNDED_SUM.aliases):
-        raise InputError(f"S-norm `{name}`: the unbounded sum is a Mamdani aggregation only, not "
-                         f"an S-norm for `or`", hint="did you mean `bounded_sum` (min(1, a + b)) "
-                                                     "or `probabilistic_sum` (a + b - a b)?")
+        # a name `or` does not take, as an unknown one (`--or sum`: a usage error, exit 2)
+        raise NameError_(f"S-norm `{name}`: the unbounded sum is a Mamdani aggregation only, "
+                         f"not an S-norm for `or`", hint="did you mean `bounded_sum` (min(1, "
+                                                         "a + b)) or `probabilistic_sum` (a + b "
+                                                         "- a b)?")
     try:
         return norms.lookup("snorm", name).name
     except KeyError:

@@ -29,6 +29,7 @@ from ..lang.parse import (
     _hedge_hint,
     _ToModel,
     _unquote,
+    check_glued_is,
     check_modifiers,
     check_nesting,
     check_settings,
@@ -391,6 +392,7 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         check_nesting(tree, line, where)
         check_modifiers(tree, line, where, TARGETS if "->" in line or
                         line.split()[:1] == ["at"] else None)
+        check_glued_is(tree, line, where)
     except RuleSyntaxError as exc:        # parsed alone: put it at its line of the lesson
         exc.span = shift(exc.span, lineno - 1)
         raise

@@ -195,6 +195,8 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
         crisp = linear_consequents(compiled, np.ascontiguousarray(res.inputs.T))[:, :, 0].T
     mamdani = compiled.operators.inference == "mamdani"
     sets = _mamdani_sets(compiled, dof) if mamdani else None
+    if compiled.operators.inference == "tsukamoto":
+        crisp = _tsukamoto_points(compiled, dof, crisp)
 
     fired = np.flatnonzero(dof > 0)
     rows = []
@@ -230,15 +232,52 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
                     tuple(inputs), tuple(rows), tuple(outputs))
 
 
+def _tsukamoto_points(compiled: CompiledRuleBase, dof: np.ndarray,
+                      crisp: np.ndarray) -> np.ndarray:
+    """``crisp`` with each rule's consequent where Tsukamoto inference puts it: its term
+    inverted at the term's activation, the summed (hedged) DOFs of the rules concluding it
+    (:mod:`mitos_cli.engine.tsukamoto`), not at the term's centre."""
+    from ...fuzzy.shapes import TSUKAMOTO
+
+    points = np.array(crisp, dtype=float)
+    for j, name in enumerate(compiled.outputs):
+        var = compiled.variables[name]
+        concluding: dict[str, list[int]] = {}
+        for r in range(compiled.n_rules):
+            term = compiled.cons_term[r][j]
+            if term is not None:
+                concluding.setdefault(term, []).append(r)
+        for term, rules in concluding.items():
+            w = sum(float(weigh(compiled.cons_hedges[r][j], np.asarray(dof[r])))
+                    if compiled.cons_hedges[r][j] else float(dof[r]) for r in rules)
+            if w > 0:
+                t = var.term(term)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    points[rules, j] = float(TSUKAMOTO[t.shape](np.asarray(w), *t.params))
+    return points
+
+
 def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.ndarray,
             dof: np.ndarray) -> tuple[tuple[float, float], ...]:
     """Output ``j``'s consequent values with the summed weights the engine averages them by: a
-    hedged consequent's is ``hedge(dof)`` (``very`` squares it), not the rule's DOF."""
+    hedged consequent's is ``hedge(dof)`` (``very`` squares it), not the rule's DOF; under
+    ``accumulation = S`` (an S-norm) the rules of one value are joined by S in rule order,
+    not summed (:func:`mitos_cli.engine.evaluation`'s accumulated inference)."""
+    from ...fuzzy import norms
+
+    accumulation = compiled.operators.accumulation
+    join = None if accumulation == "sum" else norms.lookup("snorm", accumulation)
     summed: dict[float, float] = {}
     for r in rules.tolist():
         hedges = compiled.cons_hedges[r][j]
         w = float(weigh(hedges, np.asarray(dof[r]))) if hedges else float(dof[r])
-        summed[float(crisp[r, j])] = summed.get(float(crisp[r, j]), 0.0) + w
+        value = float(crisp[r, j])
+        if value not in summed:
+            summed[value] = w
+        elif join is None:
+            summed[value] += w
+        else:
+            summed[value] = float(join(np.asarray(summed[value]), np.asarray(w)))
     return tuple(sorted(summed.items()))
 
 

@@ -93,6 +93,10 @@ class Surface:
             out.append(f"no rule sets `{self.output}` at {n} of {self.z.size} grid points "
                        f"and {no_default_words(self.nan_default)}: shown as a blank (masked) "
                        f"region")
+        infinite = int(np.isinf(self.z).sum())
+        if infinite:                # (a Tsukamoto sigmoid inverted at 1: a gap, said why)
+            out.append(f"`{self.output}` is infinite at {infinite} of {self.z.size} grid points "
+                       f"(a picture leaves them out)")
         return out
 
 
