@@ -423,12 +423,23 @@ def test_long_paths_named_inside_files_are_positioned_errors(tmp_path, monkeypat
         read_lesson(long + ".lesson")
 
 
-def test_check_threshold_nan_is_a_usage_error():
+def test_check_threshold_nan_is_a_usage_error(capsys):
     from mitos_cli.cli.app import main
 
     with pytest.raises(SystemExit) as info:
         main(["check", "--threshold", "nan"])
     assert info.value.code == 2
+
+
+def test_a_number_past_a_floats_range_is_said_as_such(capsys):
+    """``-t 1e400`` said "must be a finite number, not inf", a value the user never wrote."""
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["check", "--threshold", "1e400"])
+    said = " ".join(capsys.readouterr().err.replace("│", " ").split())
+    assert info.value.code == 2
+    assert "must be a finite number, not inf (a number past 1.8e308, such as 1e400, reads as inf)" in said
 
 
 # ---- bounded fuzzing, every input kind -----------------------------------------------------------

@@ -33,7 +33,8 @@ def finite(value: float | None) -> float | None:
     infinities, as usage errors (exit 2) instead of letting them turn a check off or reach
     the code as a traceback. ``None`` (an option left out) passes."""
     if value is not None and not math.isfinite(value):
-        raise typer.BadParameter(f"must be a finite number, not {value}")
+        past = "" if math.isnan(value) else " (a number past 1.8e308, such as 1e400, reads as inf)"
+        raise typer.BadParameter(f"must be a finite number, not {value}{past}")
     return value
 
 
