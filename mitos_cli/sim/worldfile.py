@@ -1035,11 +1035,17 @@ def walled_in(world: World, static: StaticMap, top: YMap) -> list[str]:
     return notes
 
 
+#: The most places of a mover's way :func:`_moves_into_wall` looks at (about 0.1 s of a load).
+MOVER_SAMPLES = 20_000
+
+
 def _moves_into_wall(static: StaticMap, o: Obstacle, limit: float
                      ) -> tuple[float, float, float] | None:
     """When and where (``t, x, y``, rounded to 0.1) the centre of the moving obstacle ``o``
     first passes from free space into a wall within ``limit`` seconds, looked at every inch
-    of its way (every 0.1 s where it moves slower), or None."""
+    of its way (every 0.1 s where it moves slower; at most :data:`MOVER_SAMPLES` places, so
+    a fast mover over a long time limit is looked at more coarsely, not for minutes), or
+    None."""
     import numpy as np
 
     from .obstacles import position
@@ -1048,8 +1054,9 @@ def _moves_into_wall(static: StaticMap, o: Obstacle, limit: float
     speed = float(np.hypot(*m.velocity)) if m.kind == "velocity" else m.speed
     if speed <= 0 or limit <= 0:
         return None
-    step = min(0.1, 1.0 / speed)
-    times = np.arange(int(min(limit, 3600.0) / step) + 1) * step    # (an hour of its way)
+    span = min(limit, 3600.0)                   # (an hour of its way)
+    step = max(min(0.1, 1.0 / speed), span / MOVER_SAMPLES)
+    times = np.arange(int(span / step) + 1) * step
     at = np.array([position(o, float(t)) for t in times])
     free = static.free(at)
     into = np.flatnonzero(free[:-1] & ~free[1:])
