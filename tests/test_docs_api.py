@@ -282,6 +282,43 @@ def test_every_option_the_pages_name_in_their_text_exists():
     assert unknown == [], unknown
 
 
+def test_every_script_command_the_pages_show_takes_its_options():
+    """The pages' shell blocks run `python benchmarks/NAME.py --option ...` (docs/reliability.md,
+    navigation.md, benchmarks.md) and `python -m mitos_cli.sim.barn ...`: those lines were
+    parsed by no test (the `mitos` lines are, above, and the prose's options against every
+    script at once). Each names a script that is there, and each of its options is that
+    script's own (`"--option"` in its source, as argparse is given it)."""
+    import shlex
+
+    checked, wrong = 0, []
+    pages = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md")
+                                         if p.name != "changelog.md")]
+    for page in pages:
+        for block in _shell_blocks(page.read_text(encoding="utf-8")):
+            for line in block.replace("\\\n", " ").splitlines():
+                if not line.strip().startswith(("python", "nice ")):
+                    continue
+                words = shlex.split(re.split(r"\s#\s", line.strip())[0])
+                while words and words[0] in ("nice", "-n", "19"):
+                    words = words[1:]
+                if len(words) < 2 or words[0] not in ("python", "python3"):
+                    continue
+                if words[1] == "-m" and words[2].startswith("mitos_cli."):
+                    script = ROOT / (words[2].replace(".", "/") + ".py")
+                elif words[1].startswith("benchmarks/"):
+                    script = ROOT / words[1]
+                else:                                       # -m venv, -m pytest: not ours
+                    continue
+                if not script.is_file():
+                    wrong.append(f"{page.name}: {line.strip()}: no {script.relative_to(ROOT)}")
+                    continue
+                source = script.read_text(encoding="utf-8")
+                wrong += [f"{page.name}: {line.strip()}: {w} is no option of {script.name}"
+                          for w in words if w.startswith("--") and f'"{w}"' not in source]
+                checked += 1
+    assert checked > 40 and wrong == [], wrong
+
+
 # -- every page's quick commands run as written, in the repository and away from it ---------
 #
 # A page's `mitos` lines (of its shell blocks, `\\`-continued lines joined) run in the order a
