@@ -319,6 +319,38 @@ def test_every_script_command_the_pages_show_takes_its_options():
     assert checked > 40 and wrong == [], wrong
 
 
+def test_every_module_and_name_the_pages_give_is_there():
+    """The pages name the code a reader opens or imports (`mitos_cli.gym.EnvOptionError`,
+    `mitos_cli.sim.planner.PLANNERS`, `mitos_cli/teach/instructions.py`): each dotted name
+    imports and each path is a file, so a name moved or renamed leaves no page pointing at
+    nothing (docs/architecture.md's own table is held above)."""
+    import importlib
+
+    checked, missing = 0, []
+    for page in [p for p in PAGES if p.name != "changelog.md"]:
+        text = page.read_text(encoding="utf-8")
+        for found in re.finditer(r"`(mitos_cli(?:\.\w+)+)", text):
+            parts, obj, rest = found[1].split("."), None, []
+            for i in range(len(parts), 0, -1):
+                try:
+                    obj, rest = importlib.import_module(".".join(parts[:i])), parts[i:]
+                    break
+                except ImportError:
+                    continue
+            for name in rest:
+                obj = getattr(obj, name, None)
+            line = text.count("\n", 0, found.start()) + 1
+            if obj is None:
+                missing.append(f"{page.relative_to(ROOT)}:{line}: {found[1]}")
+            checked += 1
+        for found in re.finditer(r"`(mitos_cli/[\w/]+\.(?:py|lark)|grammar/\w+\.lark)`", text):
+            if not (ROOT / found[1]).is_file():
+                line = text.count("\n", 0, found.start()) + 1
+                missing.append(f"{page.relative_to(ROOT)}:{line}: {found[1]}")
+            checked += 1
+    assert checked > 50 and missing == [], missing
+
+
 # -- every page's quick commands run as written, in the repository and away from it ---------
 #
 # A page's `mitos` lines (of its shell blocks, `\\`-continued lines joined) run in the order a
