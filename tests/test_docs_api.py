@@ -193,12 +193,26 @@ def _checkout_like(directory: Path) -> None:
         (directory / name).symlink_to(ROOT / name, target_is_directory=True)
 
 
-@pytest.mark.parametrize("page", [p for p in PAGES if python_blocks(p)],
-                         ids=lambda p: str(p.relative_to(ROOT)))
-def test_every_python_block_of_the_pages_runs_as_written(page, tmp_path, monkeypatch, capsys):
+def _python_cases() -> list:
+    """Each page with Python blocks, in a directory laid out as the repository's root and, where
+    its blocks name no file of the repository that `pip install` does not copy (docs/api.md's
+    `tests/data/tiny.yaml`), in an empty one too, as a user who installed MITOS runs them."""
+    cases = []
+    for page in [p for p in PAGES if python_blocks(p)]:
+        name = str(page.relative_to(ROOT))
+        cases.append(pytest.param(page, "repository", id=f"{name}-repository"))
+        if not any(re.search(r"[\"'](tests|benchmarks)/", code) for _, code in python_blocks(page)):
+            cases.append(pytest.param(page, "elsewhere", id=f"{name}-elsewhere"))
+    return cases
+
+
+@pytest.mark.parametrize("page, where", _python_cases())
+def test_every_python_block_of_the_pages_runs_as_written(page, where, tmp_path, monkeypatch,
+                                                         capsys):
     import textwrap
 
-    _checkout_like(tmp_path)
+    if where == "repository":
+        _checkout_like(tmp_path)
     monkeypatch.chdir(tmp_path)
     name = str(page.relative_to(ROOT))
     scope: dict = {"__name__": "__docs__"}
@@ -268,48 +282,205 @@ def test_every_option_the_pages_name_in_their_text_exists():
     assert unknown == [], unknown
 
 
-def test_the_readmes_quick_commands_run_as_written(tmp_path, monkeypatch, capsys):
-    """The README's commands run in the order a reader meets them, in a directory laid out as
-    the repository's root: every one that makes no picture and drives no more than one run
-    (no `--runs`, `--live`, `--speed`, `--plot`, `--animate`, `teach`, `compare`, `plot`; nor
-    `--planner`: DWA takes 4 s), its `> FILE` written, and a comment that gives an output's
-    value (`# tip = 7.0`) gives what it prints. `mitos eval -b drive --batch run.csv` came
-    before any command had written run.csv."""
+def test_every_script_command_the_pages_show_takes_its_options():
+    """The pages' shell blocks run `python benchmarks/NAME.py --option ...` (docs/reliability.md,
+    navigation.md, benchmarks.md) and `python -m mitos_cli.sim.barn ...`: those lines were
+    parsed by no test (the `mitos` lines are, above, and the prose's options against every
+    script at once). Each names a script that is there, and each of its options is that
+    script's own (`"--option"` in its source, as argparse is given it)."""
     import shlex
 
-    from mitos_cli.cli.app import main
+    checked, wrong = 0, []
+    pages = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md")
+                                         if p.name != "changelog.md")]
+    for page in pages:
+        for block in _shell_blocks(page.read_text(encoding="utf-8")):
+            for line in block.replace("\\\n", " ").splitlines():
+                if not line.strip().startswith(("python", "nice ")):
+                    continue
+                words = shlex.split(re.split(r"\s#\s", line.strip())[0])
+                while words and words[0] in ("nice", "-n", "19"):
+                    words = words[1:]
+                if len(words) < 2 or words[0] not in ("python", "python3"):
+                    continue
+                if words[1] == "-m" and words[2].startswith("mitos_cli."):
+                    script = ROOT / (words[2].replace(".", "/") + ".py")
+                elif words[1].startswith("benchmarks/"):
+                    script = ROOT / words[1]
+                else:                                       # -m venv, -m pytest: not ours
+                    continue
+                if not script.is_file():
+                    wrong.append(f"{page.name}: {line.strip()}: no {script.relative_to(ROOT)}")
+                    continue
+                source = script.read_text(encoding="utf-8")
+                wrong += [f"{page.name}: {line.strip()}: {w} is no option of {script.name}"
+                          for w in words if w.startswith("--") and f'"{w}"' not in source]
+                checked += 1
+    assert checked > 40 and wrong == [], wrong
 
-    slow = ("--runs", "--live", "--speed", "--plot", "--animate", "--planner")
-    _checkout_like(tmp_path)
-    monkeypatch.chdir(tmp_path)
-    ran, failed = [], []
-    for block in _shell_blocks((ROOT / "README.md").read_text(encoding="utf-8")):
-        for line in block.splitlines():
+
+def test_every_module_and_name_the_pages_give_is_there():
+    """The pages name the code and files a reader opens or imports
+    (`mitos_cli.gym.EnvOptionError`, `mitos_cli.sim.planner.PLANNERS`,
+    `mitos_cli/teach/instructions.py`, `tests/data/tiny.yaml`): each dotted name imports and
+    each path is a file, so a name moved or renamed leaves no page pointing at
+    nothing (docs/architecture.md's own table is held above)."""
+    import importlib
+
+    checked, missing = 0, []
+    for page in [p for p in PAGES if p.name != "changelog.md"]:
+        text = page.read_text(encoding="utf-8")
+        for found in re.finditer(r"`(mitos_cli(?:\.\w+)+)", text):
+            parts, obj, rest = found[1].split("."), None, []
+            for i in range(len(parts), 0, -1):
+                try:
+                    obj, rest = importlib.import_module(".".join(parts[:i])), parts[i:]
+                    break
+                except ImportError:
+                    continue
+            for name in rest:
+                obj = getattr(obj, name, None)
+            line = text.count("\n", 0, found.start()) + 1
+            if obj is None:
+                missing.append(f"{page.relative_to(ROOT)}:{line}: {found[1]}")
+            checked += 1
+        for found in re.finditer(r"`((?:mitos_cli|grammar|rulebases|worlds|tests|benchmarks)/"
+                                 r"[\w/.-]+\.\w+)`", text):
+            if "*" in found[1] or "of jFuzzyLogic's" in text[found.end():found.end() + 20]:
+                continue                    # a pattern; another project's file
+            if not (ROOT / found[1]).is_file():
+                line = text.count("\n", 0, found.start()) + 1
+                missing.append(f"{page.relative_to(ROOT)}:{line}: {found[1]}")
+            checked += 1
+    assert checked > 50 and missing == [], missing
+
+
+# -- every page's quick commands run as written, in the repository and away from it ---------
+#
+# A page's `mitos` lines (of its shell blocks, `\\`-continued lines joined) run in the order a
+# reader meets them, each page in a directory of its own: every one that makes no picture of a
+# run and drives no more than one (no `--runs`, `--live`, `--speed`, `--plot`, `--animate`,
+# `teach`, `compare`; nor `--planner`: DWA takes 4 s), its `> FILE` written. A block that the
+# line before it names as a file (`corridor.rules`: in docs/language.md) is that file, written
+# where the commands run, as a reader saves it; a line whose comment calls a file the reader's
+# own (`# in.csv: your inputs`) is not run. A comment that gives a value (`# tip = 7.0`,
+# `# 7.016879 (MATLAB: 7.0169)`, `# the paper's sample run from the FLL: 65.4, 32.4`) gives
+# what the command prints.
+#
+# "repository": in a directory laid out as the repository's root, every line exits 0.
+# "elsewhere": in an empty directory, as a user who installed MITOS runs them: a line naming
+# a folder of the repository that `pip install` does not copy (`tests/`, `benchmarks/`,
+# `docs/`) or a pattern (`worlds/*.yaml`) exits 1, with a hint where it says why; every
+# other line (the packaged worlds and rule bases go by their names and paths from anywhere)
+# runs as in the repository.
+
+SLOW_OPTIONS = ("--runs", "--live", "--speed", "--plot", "--animate", "--planner")
+REPOSITORY_ONLY = ("tests/", "benchmarks/", "docs/")
+
+
+def page_files(text: str) -> dict[str, str]:
+    """The blocks a page introduces as files, by the name on the line before their fence."""
+    lines, found = text.splitlines(), {}
+    for start, _, code in fenced_blocks(text):
+        before = next((t.strip() for t in reversed(lines[:start - 1]) if t.strip()), "")
+        named = re.fullmatch(r"`([\w.-]+\.(?:rules|ya?ml|fcl|fis|fll|csv|lesson))`:", before)
+        if named:
+            found[named[1]] = code
+    return found
+
+
+def page_commands(text: str) -> list[tuple[str, str]]:
+    """The quick `mitos` lines of a page (the rule above), each with its comment."""
+    found = []
+    for block in _shell_blocks(text):
+        for line in block.replace("\\\n", " ").splitlines():
             line = line.strip().removeprefix("$ ")
             if not line.startswith("mitos ") or "..." in line:
                 continue
             code, _, comment = line.partition(" # ")
-            words, target = shlex.split(code.split(" > ")[0]), None
-            if " > " in code:
-                target = code.split(" > ")[1].split()[0]
-            if words[1] in ("teach", "compare", "plot") or any(w in slow for w in words):
+            words = code.split()
+            if words[1] in ("teach", "compare") or any(w in SLOW_OPTIONS for w in words) \
+                    or "your" in comment:
                 continue
-            capsys.readouterr()
-            try:
-                main(words[1:])
-                status = 0
-            except SystemExit as exc:
-                status = exc.code or 0
-            out, err = capsys.readouterr()
-            if target:
-                (tmp_path / target).write_text(out, encoding="utf-8")
-            ran.append(line)
-            if status != 0:
-                failed.append(f"{line}: exit {status}: {err.strip()[:300]}")
-            said = re.match(r"\s*(\w+ = [-\d.]+)(?:\s|$)", comment)
-            if said and said[1] not in out:
-                failed.append(f"{line}: printed no `{said[1]}`")
-    assert len(ran) > 12 and failed == [], failed
+            found.append((code.strip(), comment.strip()))
+    return found
+
+
+def _said(comment: str) -> list[str]:
+    """The values a command's comment says it prints."""
+    said = re.match(r"(\w+ = [-\d.]+)(?:\s|$)", comment) or re.match(r"(-?\d[\d.]*)\b", comment)
+    if said:
+        return [said[1]]
+    listed = re.search(r": (-?\d[\d.]*(?:, -?\d[\d.]*)+)$", comment)
+    return listed[1].split(", ") if listed else []
+
+
+COMMAND_PAGES = [p for p in PAGES if p.name != "changelog.md" and page_commands(
+    p.read_text(encoding="utf-8"))]
+
+
+@pytest.mark.parametrize("where", ["repository", "elsewhere"])
+@pytest.mark.parametrize("page", COMMAND_PAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_pages_quick_commands_run_as_written(page, where, tmp_path, monkeypatch, capsys):
+    """The README's commands were run by a test, in a directory laid out as the repository's
+    root, and no other page's: docs/interop.md's `# 7.016879` and docs/language.md's
+    `mitos check corridor.rules` were held by no test, and none ran away from the repository,
+    where a new user runs them. `mitos eval -b drive --batch run.csv` came before any command
+    had written run.csv."""
+    import shlex
+
+    from mitos_cli.cli.app import main
+
+    text = page.read_text(encoding="utf-8")
+    if where == "repository":
+        _checkout_like(tmp_path)
+        (tmp_path / "docs" / "img").mkdir(parents=True)     # docs/plots.md's pictures go there
+    for name, body in page_files(text).items():
+        (tmp_path / name).write_text(body, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("COLUMNS", "100")
+    ran, failed = [], []
+    for code, comment in page_commands(text):
+        words, target = shlex.split(code.split(" > ")[0]), None
+        if " > " in code:
+            target = code.split(" > ")[1].split()[0]
+        capsys.readouterr()
+        try:
+            main(words[1:])
+            status = 0
+        except SystemExit as exc:
+            status = exc.code or 0
+        out, err = capsys.readouterr()
+        if target:
+            (tmp_path / target).write_text(out, encoding="utf-8")
+        ran.append(code)
+        if where == "elsewhere" and any(w.startswith(REPOSITORY_ONLY) or "*" in w
+                                        for w in words):
+            said = "`pip install` does not copy" if "*" not in code else "matches the pattern"
+            if status != 1 or (said not in err and not any(
+                    w.startswith("docs/") for w in words)):       # an -o there: no such folder
+                failed.append(f"{code}: exit {status}: {err.strip()[:300]}")
+            continue
+        if status != 0:
+            failed.append(f"{code}: exit {status}: {err.strip()[:300]}")
+        failed += [f"{code}: printed no `{value}`" for value in _said(comment)
+                   if not re.search(rf"(?<![\w.]){re.escape(value)}(?![\d])", out)]
+    assert ran and failed == [], failed
+
+
+def test_the_command_rule_finds_the_commands_the_pages_hold():
+    """The rule above runs the commands it is meant to, and reads the files and values the
+    pages give."""
+    found = {str(p.relative_to(ROOT)): len(page_commands(p.read_text(encoding="utf-8")))
+             for p in COMMAND_PAGES}
+    assert found == {"README.md": 19, "docs/interop.md": 16, "docs/language.md": 3,
+                     "docs/operators.md": 1, "docs/paper.md": 2, "docs/plots.md": 2}
+    language = (ROOT / "docs" / "language.md").read_text(encoding="utf-8")
+    assert sorted(page_files(language)) == ["corridor.rules", "corridor.terms.yaml"]
+    assert _said("tip = 7.0 (MATLAB: 7.0169)") == ["tip = 7.0"]
+    assert _said("7.016879 (MATLAB: 7.0169)") == ["7.016879"]
+    assert _said("the paper's sample run from the FLL: 65.4, 32.4") == ["65.4", "32.4"]
+    assert _said("a CSV, as one batch") == []
 
 
 # -- a shown session prints what it shows ------------------------------------------------------

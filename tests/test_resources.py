@@ -33,13 +33,18 @@ def test_cli_from_another_directory(tmp_path):
 def test_an_example_file_of_the_repository_named_from_elsewhere_says_where_it_is(tmp_path):
     """The README's `mitos eval tests/data/interop/tipper.fis ...` and `--batch
     tests/data/inputs.csv`, run from another directory, said "not found" and no more: those
-    files are the repository's, not packaged. From a directory with its own `tests/` the
+    files are the repository's, not packaged; so is docs/api.md's `tests/data/tiny.yaml`, a
+    world. From a directory with its own `tests/` the
     usual "did you mean" (or nothing) stands."""
     said = ("hint: `tests/` is a folder of the MITOS repository, which `pip install` does not "
             "copy: run the example from the repository's root, or name a file of your own")
     for args in (["eval", "tests/data/interop/tipper.fis", "service=2", "food=1"],
                  ["eval", "--batch", "tests/data/inputs.csv"],
-                 ["convert", "tests/data/interop/robot_jfuzzylogic.fcl", "--to", "rules"]):
+                 ["convert", "tests/data/interop/robot_jfuzzylogic.fcl", "--to", "rules"],
+                 # docs/api.md's `load_world("tests/data/tiny.yaml")`: a world said to look
+                 # among the packaged worlds by name, which this one is not
+                 ["simulate", "tests/data/tiny.yaml"],
+                 ["compare", "tests/data/tiny.yaml", "--runs", "1"]):
         res = subprocess.run([sys.executable, "-m", "mitos_cli", *args], cwd=tmp_path,
                              capture_output=True, text=True)
         assert res.returncode == 1 and "not found" in res.stderr and said in res.stderr, args

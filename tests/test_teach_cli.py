@@ -693,3 +693,18 @@ def test_a_lesson_on_stdin_is_read_as_a_lesson_file_is(work, encoding):
     assert code == 1 and "Traceback" not in err and out == ""
     assert err.splitlines()[-1] == ("<stdin>:2:16: lesson error: cannot read lesson `<stdin>`: "
                                     "it is not UTF-8 text (byte 0xe9 at line 2, column 16)")
+
+
+@pytest.mark.parametrize("lesson, says", [
+    ("rulebases/mitos.rules", "hint: `mitos.rules` is a rule base, not a lesson: give it "
+                              "before the options"),
+    ("worlds/figure4.yaml", "hint: `figure4.yaml` is a YAML file (a world, or a term set), "
+                            "not a lesson"),
+])
+def test_a_packaged_file_given_as_the_lesson_away_from_the_repository_says_what_it_is(
+        tmp_path, lesson, says):
+    """docs/teach.md: a rule file or a world given to --lesson is said to be one. Away from the
+    repository, `--lesson rulebases/mitos.rules` (a path `mitos teach` itself finds from any
+    directory) said only "lesson not found, expected a packaged lesson: wider-turn"."""
+    res = mitos("teach", "--lesson", lesson, cwd=tmp_path)
+    assert res.returncode == 1 and "not found" in res.stderr and says in res.stderr, res.stderr

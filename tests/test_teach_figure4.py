@@ -152,3 +152,30 @@ def compile_untaught(session):
     from mitos_cli.engine.compile import compile_rulebase
 
     return compile_rulebase(session.original, "drive")
+
+
+def test_what_docs_teach_md_shows_of_the_shipped_lesson_is_what_it_says(taught):
+    """docs/teach.md shows three pieces of the shipped lesson, held by no test: the examples
+    `at 13s to 14.5s make a wider turn` makes (its first line is the prompt's echo), what was
+    learned in words, and the `git diff` of the saved term sets. Each is what the lesson says
+    and saves (`...` standing for any lines)."""
+    import doctest
+    import re
+
+    from test_docs_api import fenced_blocks
+
+    _, path, said = taught
+    text = "\n".join(said) + "\n"
+    page = (ROOT / "docs" / "teach.md").read_text(encoding="utf-8")
+    blocks = [code for _, _, code in fenced_blocks(page)]
+    examples = next(b for b in blocks if b.startswith("drive> at 13s to 14.5s make a wider"))
+    words = next(b for b in blocks if b.startswith("learned, in words:"))
+    checker, flags = doctest.OutputChecker(), doctest.ELLIPSIS
+    for shown in (examples.split("\n", 1)[1], words):
+        assert checker.check_output("...\n" + shown + "...", text, flags), shown
+    diff = next(b for b in blocks if b.startswith("-      MEDIUM:"))
+    saved = "".join(p.read_text(encoding="utf-8") for p in path.parent.glob("taught.*.yaml"))
+    written = "".join((ROOT / "rulebases" / n).read_text(encoding="utf-8")
+                      for n in ("mitos.terms.yaml", "drive.terms.yaml"))
+    for sign, line in re.findall(r"^([-+])(.*)$", diff, re.M):
+        assert line in (saved if sign == "+" else written).splitlines(), (sign, line)

@@ -1159,3 +1159,32 @@ def test_show_history_says_an_adaptation_that_stopped_short(monkeypatch):
     assert "stopped" not in s.journal.entries[-1]
     last = history_text(s.journal.entries).splitlines()[-1]
     assert "adapt epochs 3   (Q " in last and ";" not in last
+
+
+def test_the_journal_docs_teach_md_shows_is_the_one_its_session_writes(tmp_path):
+    """docs/teach.md's journal showed a `simulate` by `drive` in a session that never made
+    `drive` active (no `use drive` record) and an `adapt` whose Q ended at 0.00112 with no
+    `stopped`: the session it shows, told at the prompt, writes those lines (`...` and
+    `/abs/path/` standing for any text, and the run's fingerprint not compared)."""
+    import doctest
+    import subprocess
+    import sys
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "teach.md").read_text(
+        encoding="utf-8")
+    shown = [line for line in page.splitlines() if line.startswith('{"seq":')]
+    told = ["if road is NARROW then speed is SLOW",
+            "correct road=78 size=45 position=4 -> steering=60", "adapt epochs 20", "undo",
+            "use drive", "simulate figure4"]
+    res = subprocess.run([sys.executable, "-m", "mitos_cli", "teach", "rulebases/mitos.rules"],
+                         cwd=tmp_path, input="\n".join(told) + "\n", capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    (journal,) = (tmp_path / ".mitos" / "teach").glob("*/journal.jsonl")
+    written = journal.read_text(encoding="utf-8").splitlines()
+    assert len(written) == len(shown) == 7
+    checker = doctest.OutputChecker()
+    for want, got in zip(shown, written):
+        # the run's fingerprint hashes pose bits, which another libm may round otherwise
+        want = re.sub(r'"run":"[0-9a-f]+"', '"run":"..."', want.replace("/abs/path/", "..."))
+        assert checker.check_output(want + "\n", got + "\n", doctest.ELLIPSIS), (want, got)

@@ -1479,6 +1479,7 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
     listed when the name was one's (``slalm``) or is close to one, not for any path
     (``nosuch.yaml``, ``foo/nosuch.yaml``: "did you mean office.yaml" was the shared ``.yaml``)."""
     from ..errors import closest_file
+    from ..fileio import repository_only
     from ..resources import packaged_names, packaged_place
 
     given = Path(name)
@@ -1499,6 +1500,7 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
     if any(c in given.name for c in "*?["):       # `worlds/*.yaml` away from the repository
         hint = (f"no file here matches the pattern, so the shell passed `{name}` on as "
                 f"written; the packaged worlds go by name: `mitos list` shows them")
-    if hint is None and listing is None:
-        hint = "`mitos list` shows the packaged worlds, which are found by name (`slalom`)"
+    if hint is None and listing is None:       # `tests/data/tiny.yaml` away from the repository
+        hint = repository_only(name) or \
+            "`mitos list` shows the packaged worlds, which are found by name (`slalom`)"
     return UnknownWorld(f"world file `{name}` not found", expected=listing, hint=hint)

@@ -195,7 +195,12 @@ def read_lesson(source: str) -> tuple[str, str]:
 
             names = [n[:-len(".lesson")] for n in packaged_names("rulebases/lessons", ".lesson")]
             error.expected = "a lesson file, or a packaged lesson: " + ", ".join(names)
-            error.hint = nearby(path, (".lesson",)) or did_you_mean(path.stem, names)
+            # `--lesson rulebases/mitos.rules` away from the repository: a packaged file, of
+            # another kind, which `mitos teach` finds from anywhere
+            packaged = path.suffix and (resolve("rulebases", source, ".rules")
+                                        or resolve("worlds", source, ".yaml"))
+            error.hint = (not_a_lesson(source) if packaged else None) \
+                or nearby(path, (".lesson",)) or did_you_mean(path.stem, names)
         raise error from None
     check_lesson_size(text, source)             # before a session exists
     return text, source
