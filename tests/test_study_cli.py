@@ -188,8 +188,8 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     (["TINY", "TINY"], 2, "given twice"),
     (["TINY", "TINY_AGAIN"], 2, "given twice"),    # (another spelling: Study's exit 1)
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
-    (["TINY", "--runs", "1000000"], 2, "is not in the range 1<=x<=100000"),   # (no memory
-    (["TINY", "-n", "1000000"], 2, "is not in the range 1<=x<=100000"),       # for the tasks)
+    (["TINY", "--runs", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # (no
+    (["TINY", "-n", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # memory)
 ])
 def test_user_errors(tiny, tmp_path, compare, args, code, words):
     again = str(Path(tiny).parent / ".." / Path(tiny).parent.name / "tiny.yaml")

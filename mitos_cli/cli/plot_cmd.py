@@ -23,7 +23,16 @@ from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .meant import MeantGroup
 from .output import emit, err, warn
-from .params import WORDS, OnceCommand, choice, choices, completer, named, not_a_directory_name
+from .params import (
+    WORDS,
+    Number,
+    OnceCommand,
+    choice,
+    choices,
+    completer,
+    named,
+    not_a_directory_name,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -141,8 +150,9 @@ def _use_color(color: Optional[bool]) -> bool:
 
 
 #: the terminal drawing's options
+WIDTH = Number("the plot's width in characters", 30, 400)
 WidthOpt = Annotated[Optional[int], typer.Option(
-    "--width", metavar="N", min=30, max=400,
+    "--width", metavar="N", click_type=WIDTH,
     help="Terminal plot width in characters (default: the terminal's, at most 100).")]
 ColorOpt = Annotated[Optional[bool], typer.Option(
     "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
@@ -326,7 +336,9 @@ def surface_command(
         help="Hold another input at a value (repeat; inputs not fixed are held at the "
              "midpoint of their universe, with a note).")] = None,
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", metavar="N", min=2, max=1000, help="Grid points per axis.")] = 61,
+        "--resolution", "-n", metavar="N",
+        click_type=Number("the number of grid points per axis", 2, 1000),
+        help="Grid points per axis.")] = 61,
     style_name: Annotated[Optional[str], typer.Option(
         "--style", metavar=choices(Style), autocompletion=completer(Style),
         help="surface: a 3-D surface (the default); heatmap: a heat map with contour lines. "
@@ -393,10 +405,10 @@ def rules_command(
     title: TitleOpt = None,
     behavior: BehaviorOpt = None,
     max_rules: Annotated[int, typer.Option(
-        "--max-rules", metavar="N", min=1, max=500,
+        "--max-rules", metavar="N", click_type=Number("the number of fired rules to draw", 1, 500),
         help="Draw at most this many fired rules (the strongest).")] = 30,
     width: Annotated[Optional[int], typer.Option(
-        "--width", metavar="N", min=30, max=400,
+        "--width", metavar="N", click_type=WIDTH,
         help="Width in characters of a Mamdani output's plot in the text viewer "
              "(default 72).")] = None,
     color: ColorOpt = None,
