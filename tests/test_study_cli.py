@@ -183,6 +183,9 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     (["TINY", "--or", "max,unbounded_sum"], 2, "did you mean `bounded_sum`"),
     (["TINY", "--planner", "potential"], 2, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
+    # an empty address ran the study on this machine without a word, as if left out
+    (["TINY", "--scheduler", ""], 2, "'--scheduler': must name something, not be empty"),
+    (["TINY", "--executor", "dask", "--scheduler", " "], 2, "must name something, not be empty"),
     (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),

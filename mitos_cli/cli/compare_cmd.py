@@ -67,7 +67,7 @@ def compare_command(
         help="Processes (local) or LocalCluster workers (dask). Default: the CPUs allowed, "
              "fewer where memory is short.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(
-        "--scheduler", metavar="ADDR",
+        "--scheduler", metavar="ADDR", callback=named,
         help="Dask scheduler address (tcp://host:8786); without it a LocalCluster.")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv "
