@@ -678,6 +678,19 @@ def test_cli_user_errors_exit_1(capsys, args, message):
     (["convert", "rulebases/mitos.rules", "--to", "fll", "--to", "fis"], "'--to' is given twice"),
     (["plot", "surface", "steering", "--x", "road", "--x", "size"], "'--x' is given twice"),
     (["check", "--threshold", "0.1", "--threshold", "0.2"], "'--threshold' / '-t' is given twice"),
+    # an empty name, as `-b ''` and `mitos check ''` are refused: these were exit 1 ("unknown
+    # variable ``", "the rule base's name is empty ... or None for the packaged one": words
+    # for a Python caller) or said "`` has no extension"
+    (["plot", "terms", ""], "'[RULEBASE] [NAME=VALUE]...': must name something, not be empty"),
+    (["plot", "rules", "", "road=1"], "'[RULEBASE] NAME=VALUE...': must name something, not be "
+                                      "empty"),
+    (["plot", "surface", "", "steering"], "'[RULEBASE] [OUTPUT]': must name something, not be "
+                                          "empty"),
+    (["plot", "terms", "--var", "road", "--var", ""], "'--var' / '-v': must name something"),
+    (["plot", "surface", "--x", ""], "'--x': must name something, not be empty"),
+    (["plot", "surface", "--x", "road", "--y", " "], "'--y': must name something, not be empty"),
+    (["plot", "terms", "-o", ""], "'--output' / '-o': must name something, not be empty"),
+    (["teach", "--resume", "--session", ""], "'--session': must name something, not be empty"),
 ])
 def test_cli_usage_errors_exit_2(capsys, args, message):
     code, out, err = run_main(args, capsys)

@@ -67,6 +67,7 @@ def picture_path(path: Optional[str], option: str) -> Optional[str]:
     """The picture file an ``option`` names, a .png or .svg one (usage error otherwise)."""
     if path is None:
         return None
+    named(path)                        # (`-o ''` said "`` has no extension")
     suffix = Path(not_a_directory_name(path)).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise typer.BadParameter(
@@ -170,12 +171,13 @@ def _terminal_width(width: Optional[int]) -> int:
 
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] [NAME=VALUE]...",
+        click_type=WORDS, metavar="[RULEBASE] [NAME=VALUE]...", callback=named,
         help="Rule file (default: the packaged MITOS rule base) or a term set "
              "(FILE.terms.yaml), then values to mark, "
              "e.g. road=78.")] = None,
     var: Annotated[Optional[list[str]], typer.Option(
-        "--var", "-v", metavar="NAME", help="Draw only this variable (repeat for more).")] = None,
+        "--var", "-v", metavar="NAME", callback=named,
+        help="Draw only this variable (repeat for more).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,
         help="Draw only the variables this behavior uses.")] = None,
@@ -321,15 +323,15 @@ def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
 
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] [OUTPUT]",
+        click_type=WORDS, metavar="[RULEBASE] [OUTPUT]", callback=named,
         help="Rule file (default: the packaged MITOS rule base), then the output to draw "
              "(default: the behavior's first, with a note).")] = None,
     x: Annotated[Optional[str], typer.Option(
-        "--x", metavar="INPUT[=LOW:HIGH]",
+        "--x", metavar="INPUT[=LOW:HIGH]", callback=named,
         help="Input on the x axis, optionally zoomed to LOW:HIGH (default: the behavior's "
              "first input, and its second on the y axis, as MATLAB's gensurf).")] = None,
     y: Annotated[Optional[str], typer.Option(
-        "--y", metavar="INPUT[=LOW:HIGH]",
+        "--y", metavar="INPUT[=LOW:HIGH]", callback=named,
         help="Input on the y axis (with --x alone: a curve over --x).")] = None,
     fix: Annotated[Optional[list[str]], typer.Option(
         "--fix", metavar="NAME=VALUE",
@@ -397,7 +399,7 @@ def _used_values(rb: LoadedRuleBase, texts: dict[str, str]) -> dict[str, float]:
 
 def rules_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...",
+        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...", callback=named,
         help="Rule file (default: the packaged MITOS rule base), then one NAME=VALUE per "
              "input.")] = None,
     output: OutputOpt = None,
