@@ -350,6 +350,13 @@ class ResultStore:
                              "leave out --resume to start a study there")
         parent = self.dir.parent
         if not there and not parent.is_dir():
+            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
+            # `mkdir -p notes.txt` were no help
+            found = next((p for p in (parent, *parent.parents) if p.exists()), None)
+            if found is not None and not found.is_dir():
+                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
+                                 f"is a file, not a directory",
+                                 hint="choose another directory with -o")
             # the directory alone is made, as every other writer makes only its file: a
             # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
             raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
