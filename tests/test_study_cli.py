@@ -191,6 +191,8 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     (["TINY", "TINY"], 2, "given twice"),
     (["TINY", "TINY_AGAIN"], 2, "given twice"),    # (another spelling: Study's exit 1)
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
+    # an unknown planner is said as such, not as one without a fuzzy planner
+    (["TINY", "--planner", "dwaa", "--and", "product"], 2, "unknown planner `dwaa`"),
     (["TINY", "--runs", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # (no
     (["TINY", "-n", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # memory)
 ])

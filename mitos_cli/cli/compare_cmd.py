@@ -170,11 +170,14 @@ def _planners(planner: str, and_: str, or_: str | None, inference: str | None, r
               behavior: str | None) -> list[str]:
     """``--planner``'s names; the fuzzy planner's options without it are refused (they were
     dropped without a word)."""
-    from ..study.spec import split_list
+    from ..study.spec import PLANNERS, split_list
 
     planners = split_list(planner)
     if not planners:
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
+    for name in planners:           # before what the planners lack (`--planner dwaa --and min`
+        if name not in PLANNERS:    # said "--planner dwaa has no fuzzy planner")
+            raise unknown("planner", name, PLANNERS, cls=UsageError)
     for flag, names, what in (("--and", and_, "T-norm"), ("--or", or_, "S-norm"),
                               ("--inference", inference, "inference method")):
         if names is not None and not split_list(names):     # (`--and ,` ran the rule base's)
