@@ -246,6 +246,11 @@ def test_usage_errors_exit_2(capsys, args, message):
      "range -inf:20 of `position`: `-inf` is not a finite number", None),
     (["surface", "steering", "--x", "road=0:inf"],
      "range 0:inf of `road`: `inf` is not a finite number", None),
+    # 1e400 is said as written (it said "range 0:inf ...: `inf` is not a finite number")
+    (["surface", "steering", "--x", "road=0:1e400"],
+     "range 0:1e400 of `road` has a number too large for a float: `1e400`", None),
+    (["surface", "steering", "--x", "road", "--y", "position=-1e999:4"],
+     "range -1e999:4 of `position` has a number too large for a float: `-1e999`", None),
     (["surface", "steering", "--x", "road", "--fix", "size=nan"],
      "--fix size=nan: `nan` is not a number", None),
     (["surface", "steering", "--x", "heading"],

@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ..errors import UsageError
-from ..numbers import parse_number
+from ..errors import InputError, UsageError
+from ..numbers import parse_value
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .meant import MeantGroup
@@ -258,10 +258,25 @@ def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
     try:
         if not colon:
             raise ValueError
-        return name, (parse_number(lo), parse_number(hi))
+        return name, (parse_value(lo), parse_value(hi))
+    except OverflowError:           # (`1e400` read as inf was said as `inf`, never written)
+        big = next(t for t in (lo, hi) if not _fits(t))
+        raise InputError(f"range {rng} of `{name}` has a number too large for a float: `{big}`",
+                         expected="numbers of magnitude at most 1.8e308") from None
     except ValueError:
         raise typer.BadParameter(f"`{text}`: write NAME or NAME=LOW:HIGH, e.g. {name}=40:100",
                                  param_hint=option) from None
+
+
+def _fits(text: str) -> bool:
+    """Whether ``text`` reads as a number inside a float's range (or as written, ``inf``)."""
+    try:
+        parse_value(text)
+    except OverflowError:
+        return False
+    except ValueError:
+        pass
+    return True
 
 
 def _fixed(items: list[str]) -> dict[str, str]:
