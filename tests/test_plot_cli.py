@@ -221,6 +221,15 @@ def test_usage_errors_exit_2(capsys, args, message):
     assert message in " ".join(err.replace("│", " ").split())
 
 
+@pytest.mark.parametrize("fix", ["size", "", "size=1 size=2"])
+def test_a_malformed_fix_is_refused_before_any_note(capsys, fix):
+    """`plot surface steering --fix size` printed "note: drawing over `road` and `size`, the
+    first inputs" and then the usage error: a note about a drawing that was never made."""
+    fixes = [w for f in fix.split(" ") for w in ("--fix", f)]
+    code, out, err = run(["plot", "surface", "steering", *fixes], capsys)
+    assert code == 2 and err.startswith("Usage: mitos plot surface"), err
+
+
 @pytest.mark.parametrize("args, message, hint", [
     (["terms", "--var", "raod"], "unknown variable `raod`", "did you mean `road`?"),
     (["terms", "road=wide"], "input `road` must be a number, not `wide`", None),

@@ -380,13 +380,14 @@ def surface_command(
                                    or not _wants_picture(output, show)):
         raise typer.BadParameter(STYLE_NEEDS)
     path, out_name = _surface_args(args or [])
+    held = _fixed(fix or [])            # (a malformed --fix followed a note on the axes)
     rb = load_rulebase(path, behavior)
     out_name, x, y = _surface_defaults(rb, out_name, x, y)
     if style_name is not None and y is None:          # a behavior of one input: a curve
         raise typer.BadParameter(STYLE_NEEDS)
     x_name, x_range = _axis(x, "'--x'")
     y_name, y_range = _axis(y, "'--y'") if y is not None else (None, None)
-    fixed = parse_values(_fixed(fix or []))
+    fixed = parse_values(held)
     s = surface(rb.compiled, out_name, x_name, y_name, fixed, resolution, x_range, y_range)
     for note in s.notes():
         err(f"note: {note}")
