@@ -221,6 +221,16 @@ def test_usage_errors_exit_2(capsys, args, message):
     assert message in " ".join(err.replace("│", " ").split())
 
 
+@pytest.mark.parametrize("args", [["steerin"], ["steering", "--fix", "sise=4"],
+                                  ["steering", "--fix", "size=1e400"],
+                                  ["steering", "--fix", "size=nan"]])
+def test_a_surface_refused_says_no_note_on_what_it_would_draw(capsys, args):
+    """`plot surface steerin` printed "note: drawing over `road` and `size`, the first
+    inputs" before "unknown output `steerin`": a note on a drawing that was never made."""
+    code, out, err = run(["plot", "surface", *args], capsys)
+    assert code in (1, 2) and "note:" not in err and out == "", err
+
+
 @pytest.mark.parametrize("fix", ["size", "", "size=1 size=2"])
 def test_a_malformed_fix_is_refused_before_any_note(capsys, fix):
     """`plot surface steering --fix size` printed "note: drawing over `road` and `size`, the

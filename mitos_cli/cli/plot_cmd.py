@@ -318,9 +318,10 @@ STYLE_NEEDS = ("--style chooses how a picture of two inputs is drawn: add --y an
 
 
 def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
-                      y: str | None) -> tuple[str, str, str | None]:
+                      y: str | None) -> tuple[str, str, str | None, list[str]]:
     """What `mitos plot surface` draws when told less, as MATLAB's ``gensurf(fis)``: the
-    behavior's first output over its first two inputs, each default said in a note."""
+    behavior's first output over its first two inputs, and the note that says each default
+    (printed once the surface is made: before an error it spoke of a drawing never made)."""
     chose = []
     if out_name is None:
         out_name = rb.outputs[0]
@@ -331,9 +332,7 @@ def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
         x, y = rb.inputs[0], rb.inputs[1] if len(rb.inputs) > 1 else None
         over = f"`{x}`" + (f" and `{y}`" if y is not None else "")
         chose.append(f"over {over}, the first inputs (--x and --y choose others)")
-    if chose:
-        err("note: drawing " + "; ".join(chose))
-    return out_name, x, y
+    return out_name, x, y, ["drawing " + "; ".join(chose)] if chose else []
 
 
 def surface_command(
@@ -382,14 +381,14 @@ def surface_command(
     path, out_name = _surface_args(args or [])
     held = _fixed(fix or [])            # (a malformed --fix followed a note on the axes)
     rb = load_rulebase(path, behavior)
-    out_name, x, y = _surface_defaults(rb, out_name, x, y)
+    out_name, x, y, chosen = _surface_defaults(rb, out_name, x, y)
     if style_name is not None and y is None:          # a behavior of one input: a curve
         raise typer.BadParameter(STYLE_NEEDS)
     x_name, x_range = _axis(x, "'--x'")
     y_name, y_range = _axis(y, "'--y'") if y is not None else (None, None)
     fixed = parse_values(held)
     s = surface(rb.compiled, out_name, x_name, y_name, fixed, resolution, x_range, y_range)
-    for note in s.notes():
+    for note in [*chosen, *s.notes()]:
         err(f"note: {note}")
     if not _wants_picture(output, show):
         from ..draw.terminal import render_surface
