@@ -714,9 +714,13 @@ def test_every_command_refuses_a_single_value_option_given_twice():
 
 
 def said_in_the_box(err: str) -> str:
-    """The message of a usage error, as one line (Rich's box, unwrapped)."""
+    """The message of a usage error, as one line (Rich's box unwrapped; Click's own
+    ``Error: ...`` where Typer runs without Rich)."""
     lines = err.splitlines()
-    top = next(i for i, line in enumerate(lines) if line.startswith("\u256d"))
+    top = next((i for i, line in enumerate(lines) if line.startswith("\u256d")), None)
+    if top is None:
+        return " ".join(line.removeprefix("Error: ") for line in lines
+                        if not line.startswith(("Usage:", "Try ")))
     inside = lines[top + 1:next(i for i, line in enumerate(lines) if line.startswith("\u2570"))]
     return " ".join(" ".join(line.strip("\u2502").split()) for line in inside)
 
