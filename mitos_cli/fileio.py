@@ -203,6 +203,21 @@ def real_path(path: str | Path) -> Path:
         return Path(os.path.abspath(path))
 
 
+#: what to do where a file stands in the place of a directory
+IN_THE_WAY_HINT = "give a path inside a directory"
+
+
+def file_in_the_way(directory: Path) -> Path | None:
+    """The file that stands where ``directory`` or one of the directories above it should be
+    (``notes.txt`` for ``notes.txt/a``), or None. The system says "No such file or
+    directory" or "Not a directory" there, and a hint to create the directory cannot help."""
+    try:
+        found = next((p for p in (directory, *directory.parents) if p.exists()), None)
+        return found if found is not None and not found.is_dir() else None
+    except OSError:
+        return None
+
+
 def check_writable(path: str | Path) -> None:
     """Refuse, before any work, a file that cannot be written where it is named: its directory
     missing or not writable, the name a directory's, or a link in a loop (a device or a pipe,
@@ -219,6 +234,10 @@ def check_writable(path: str | Path) -> None:
             raise WriteError(f"cannot write `{path}`: it is a directory",
                              hint="give a file name inside it")
         parent = path.parent if str(path.parent) else Path(".")
+        blocker = None if parent.is_dir() else file_in_the_way(parent)
+        if blocker is not None:
+            raise WriteError(f"cannot write `{path}`: `{blocker}` is a file, not a directory",
+                             hint=IN_THE_WAY_HINT)
         why = ("No such file or directory" if not parent.is_dir() else
                "Permission denied" if not os.access(parent, os.W_OK | os.X_OK) else None)
     except OSError as exc:          # a name the system cannot look up (over 255 characters)
@@ -304,6 +323,10 @@ def atomic_file(path: str | Path, binary: bool = False,
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
     except OSError as exc:
+        blocker = file_in_the_way(directory)
+        if blocker is not None:
+            raise error(f"cannot write `{path}`: `{blocker}` is a file, not a directory",
+                        hint=IN_THE_WAY_HINT) from None
         raise error(f"cannot write `{path}`: {exc.strerror or exc}",
                     hint="check that the directory exists and is writable") from None
     _keep_mode(fd, path)

@@ -678,6 +678,19 @@ def test_cli_user_errors_exit_1(capsys, args, message):
     (["convert", "rulebases/mitos.rules", "--to", "fll", "--to", "fis"], "'--to' is given twice"),
     (["plot", "surface", "steering", "--x", "road", "--x", "size"], "'--x' is given twice"),
     (["check", "--threshold", "0.1", "--threshold", "0.2"], "'--threshold' / '-t' is given twice"),
+    # an empty name, as `-b ''` and `mitos check ''` are refused: these were exit 1 ("unknown
+    # variable ``", "the rule base's name is empty ... or None for the packaged one": words
+    # for a Python caller) or said "`` has no extension"
+    (["plot", "terms", ""], "'[RULEBASE] [NAME=VALUE]...': must name something, not be empty"),
+    (["plot", "rules", "", "road=1"], "'[RULEBASE] NAME=VALUE...': must name something, not be "
+                                      "empty"),
+    (["plot", "surface", "", "steering"], "'[RULEBASE] [OUTPUT]': must name something, not be "
+                                          "empty"),
+    (["plot", "terms", "--var", "road", "--var", ""], "'--var' / '-v': must name something"),
+    (["plot", "surface", "--x", ""], "'--x': must name something, not be empty"),
+    (["plot", "surface", "--x", "road", "--y", " "], "'--y': must name something, not be empty"),
+    (["plot", "terms", "-o", ""], "'--output' / '-o': must name something, not be empty"),
+    (["teach", "--resume", "--session", ""], "'--session': must name something, not be empty"),
 ])
 def test_cli_usage_errors_exit_2(capsys, args, message):
     code, out, err = run_main(args, capsys)
@@ -698,6 +711,116 @@ def test_every_command_refuses_a_single_value_option_given_twice():
 
     commands = leaves(typer.main.get_command(build_app()))
     assert len(commands) >= 12 and all(isinstance(c, OnceCommand) for c in commands)
+
+
+def said_in_the_box(err: str) -> str:
+    """The message of a usage error, as one line (Rich's box unwrapped; Click's own
+    ``Error: ...`` where Typer runs without Rich)."""
+    lines = err.splitlines()
+    top = next((i for i, line in enumerate(lines) if line.startswith("\u256d")), None)
+    if top is None:
+        return " ".join(line.removeprefix("Error: ") for line in lines
+                        if not line.startswith(("Usage:", "Try ")))
+    inside = lines[top + 1:next(i for i, line in enumerate(lines) if line.startswith("\u2570"))]
+    return " ".join(" ".join(line.strip("\u2502").split()) for line in inside)
+
+
+WHOLE = "must be a whole number"
+PAST = "(past 1.8e308, the largest number a float holds)"
+DIGITS = "(write it with the digits 0 to 9)"
+
+
+@pytest.mark.parametrize("args, message", [
+    # a word, a negative, zero, nan, inf, 1e400, empty, a fraction, an exponent: each option's
+    # meaning, what it takes and what was given, where Click said "'abc' is not a valid int
+    # range" or "0 is not in the range x>=1"
+    (["check", "-n", "abc"], "'--resolution' / '-n': the number of grid points per input "
+                             f"{WHOLE} from 2 to 10000, not `abc`"),
+    (["check", "-n", "1"], f"'--resolution' / '-n': the number of grid points per input {WHOLE} "
+                           "from 2 to 10000, not `1`"),
+    (["check", "-n", ""], f"'--resolution' / '-n': the number of grid points per input {WHOLE} "
+                          "from 2 to 10000, not an empty value"),
+    (["check", "-t", "-1"], "'--threshold' / '-t': the DOF threshold must be a number of 0 or "
+                            "more, not `-1`"),
+    (["check", "-t", "-inf"], "'--threshold' / '-t': the DOF threshold must be a number of 0 or "
+                              "more, not `-inf`"),
+    (["check", "-t", "nan"], "'--threshold' / '-t': the DOF threshold must be a number of 0 or "
+                             "more, not `nan`"),
+    (["check", "-t", "1e400"], "'--threshold' / '-t': the DOF threshold must be a number of 0 or "
+                               f"more, not `1e400` {PAST}"),
+    (["eval", "--digits", "2.5", "road=1"], f"'--digits': the number of decimals {WHOLE} from 0 "
+                                            "to 12, not `2.5`"),
+    (["eval", "--digits", "13", "road=1"], f"'--digits': the number of decimals {WHOLE} from 0 "
+                                           "to 12, not `13`"),
+    (["simulate", "--seed", "-1"], f"'--seed': the seed {WHOLE} of 0 or more, not `-1`"),
+    (["simulate", "--seed", "inf"], f"'--seed': the seed {WHOLE} of 0 or more, not `inf`"),
+    (["simulate", "--runs", "-1"], "'--runs': the number of randomised runs per world "
+                                   f"{WHOLE} from 0 to 100000, not `-1`"),
+    (["simulate", "--every", "0"], f"'--every': the number of ticks between traces {WHOLE} of 1 "
+                                   "or more, not `0`"),
+    (["simulate", "--speed", "x"], "'--speed': the real-time factor must be a number of 0 or "
+                                   "more, not `x`"),
+    (["simulate", "--fps", "0"], "'--fps': the frames per second must be a number from 0.1 to "
+                                 "60, not `0`"),
+    (["simulate", "--fps", "1e400"], "'--fps': the frames per second must be a number from 0.1 "
+                                     f"to 60, not `1e400` {PAST}"),
+    (["simulate", "-j", "0"], f"'--workers' / '-j': the number of processes {WHOLE} of 1 or "
+                              "more, not `0`"),
+    (["compare", "corridor", "--runs", "1e3"], "'--runs': the number of runs per world and "
+                                               f"choice {WHOLE} from 1 to 100000, not `1e3` "
+                                               "(write it in digits: 1000)"),
+    (["compare", "corridor", "-n", "0"], "'-n': the number of runs per world and choice "
+                                         f"{WHOLE} from 1 to 100000, not `0`"),
+    (["compare", "corridor", "--seed", "abc"], f"'--seed': the study's seed {WHOLE} of 0 or "
+                                               "more, not `abc`"),
+    (["compare", "corridor", "-j", "2.5"], "'--workers' / '-j': the number of processes "
+                                           f"{WHOLE} of 1 or more, not `2.5`"),
+    (["plot", "terms", "--width", "5"], "'--width': the plot's width in characters "
+                                        f"{WHOLE} from 30 to 400, not `5`"),
+    (["plot", "surface", "-n", "nan"], "'--resolution' / '-n': the number of grid points per "
+                                       f"axis {WHOLE} from 2 to 1000, not `nan`"),
+    (["plot", "rules", "--max-rules", "0", "road=1"], "'--max-rules': the number of fired rules "
+                                                      f"to draw {WHOLE} from 1 to 500, not `0`"),
+    (["plot", "rules", "--width", "-1", "road=1"], "'--width': the plot's width in characters "
+                                                   f"{WHOLE} from 30 to 400, not `-1`"),
+    # Python's int() and float() read `1_0` as 10 and other scripts' digits (`١٠`) as 10:
+    # a number written as no file format or other option here writes it ran as another
+    (["simulate", "--seed", "1_0"], f"'--seed': the seed {WHOLE} of 0 or more, not `1_0` {DIGITS}"),
+    (["simulate", "--seed", "\u0661\u0660"], f"'--seed': the seed {WHOLE} of 0 or more, not "
+                                             f"`\u0661\u0660` {DIGITS}"),
+    (["check", "-t", "0_5"], "'--threshold' / '-t': the DOF threshold must be a number of 0 or "
+                             f"more, not `0_5` {DIGITS}"),
+    (["simulate", "--seed", "9" * 5000], f"'--seed': the seed {WHOLE} of 0 or more, not "
+                                         f"`{'9' * 20}...{'9' * 10}` (5,000 characters): Python "
+                                         "reads whole numbers of at most 4,300 digits"),
+])
+def test_a_number_option_says_what_it_takes(capsys, args, message):
+    code, out, err = run_main(args, capsys)
+    assert (code, out) == (2, "")
+    assert said_in_the_box(err) == f"Invalid value for {message}"
+
+
+def test_every_number_option_is_read_by_one_type():
+    """Click's own number types word their errors in Click's terms ("'abc' is not a valid
+    int range"); every option that takes a number takes it through one type,
+    :class:`~mitos_cli.cli.params.Number`, which says the option's meaning, the range and
+    what was given."""
+    import typer.main
+    from typer._click.types import FloatParamType, IntParamType
+
+    from mitos_cli.cli.app import build_app
+    from mitos_cli.cli.params import Number
+
+    def leaves(cmd, path):
+        subs = getattr(cmd, "commands", None)
+        return [x for n, s in subs.items() for x in leaves(s, f"{path} {n}".strip())] if subs \
+            else [(path, cmd)]
+
+    numbers = {f"{path} {param.opts[0]}": type(param.type).__name__
+               for path, cmd in leaves(typer.main.get_command(build_app()), "")
+               for param in cmd.params
+               if isinstance(param.type, (IntParamType, FloatParamType, Number))}
+    assert len(numbers) == 17 and set(numbers.values()) == {"Number"}, numbers
 
 
 def test_cli_syntax_error_through_a_real_process(tmp_path):

@@ -55,6 +55,24 @@ def test_a_write_that_fails_is_a_write_error(tmp_path):
                                   f"file or directory")
 
 
+@pytest.mark.parametrize("under", ["x.csv", "a/x.csv"])
+def test_a_file_where_a_directory_goes_is_named(tmp_path, under):
+    """`simulate -o notes.txt/x.csv` said "No such file or directory" and hinted to check
+    that the directory exists, where it is a file in the way: the check before the work and
+    the write itself both name it."""
+    from mitos_cli.errors import WriteError
+    from mitos_cli.fileio import check_writable
+
+    (tmp_path / "notes.txt").write_text("x\n")
+    target = tmp_path / "notes.txt" / under
+    for write in (check_writable, lambda p: atomic_write(p, "x")):
+        with pytest.raises(WriteError) as info:
+            write(target)
+        assert info.value.message == (f"cannot write `{target}`: `{tmp_path / 'notes.txt'}` "
+                                      f"is a file, not a directory")
+        assert info.value.hint == "give a path inside a directory"
+
+
 def test_replace_failing_is_an_error_and_leaves_nothing(tmp_path, monkeypatch):
     target = tmp_path / "a.txt"
     target.write_text("old")

@@ -221,6 +221,25 @@ def test_usage_errors_exit_2(capsys, args, message):
     assert message in " ".join(err.replace("│", " ").split())
 
 
+@pytest.mark.parametrize("args", [["steerin"], ["steering", "--fix", "sise=4"],
+                                  ["steering", "--fix", "size=1e400"],
+                                  ["steering", "--fix", "size=nan"]])
+def test_a_surface_refused_says_no_note_on_what_it_would_draw(capsys, args):
+    """`plot surface steerin` printed "note: drawing over `road` and `size`, the first
+    inputs" before "unknown output `steerin`": a note on a drawing that was never made."""
+    code, out, err = run(["plot", "surface", *args], capsys)
+    assert code in (1, 2) and "note:" not in err and out == "", err
+
+
+@pytest.mark.parametrize("fix", ["size", "", "size=1 size=2"])
+def test_a_malformed_fix_is_refused_before_any_note(capsys, fix):
+    """`plot surface steering --fix size` printed "note: drawing over `road` and `size`, the
+    first inputs" and then the usage error: a note about a drawing that was never made."""
+    fixes = [w for f in fix.split(" ") for w in ("--fix", f)]
+    code, out, err = run(["plot", "surface", "steering", *fixes], capsys)
+    assert code == 2 and err.startswith("Usage: mitos plot surface"), err
+
+
 @pytest.mark.parametrize("args, message, hint", [
     (["terms", "--var", "raod"], "unknown variable `raod`", "did you mean `road`?"),
     (["terms", "road=wide"], "input `road` must be a number, not `wide`", None),
@@ -246,6 +265,11 @@ def test_usage_errors_exit_2(capsys, args, message):
      "range -inf:20 of `position`: `-inf` is not a finite number", None),
     (["surface", "steering", "--x", "road=0:inf"],
      "range 0:inf of `road`: `inf` is not a finite number", None),
+    # 1e400 is said as written (it said "range 0:inf ...: `inf` is not a finite number")
+    (["surface", "steering", "--x", "road=0:1e400"],
+     "range 0:1e400 of `road` has a number too large for a float: `1e400`", None),
+    (["surface", "steering", "--x", "road", "--y", "position=-1e999:4"],
+     "range -1e999:4 of `position` has a number too large for a float: `-1e999`", None),
     (["surface", "steering", "--x", "road", "--fix", "size=nan"],
      "--fix size=nan: `nan` is not a number", None),
     (["surface", "steering", "--x", "heading"],

@@ -432,14 +432,16 @@ def test_check_threshold_nan_is_a_usage_error(capsys):
 
 
 def test_a_number_past_a_floats_range_is_said_as_such(capsys):
-    """``-t 1e400`` said "must be a finite number, not inf", a value the user never wrote."""
+    """``-t 1e400`` said "must be a finite number, not inf", a value the user never wrote:
+    it is said as written, with why it is no number here."""
     from mitos_cli.cli.app import main
 
     with pytest.raises(SystemExit) as info:
         main(["check", "--threshold", "1e400"])
     said = " ".join(capsys.readouterr().err.replace("│", " ").split())
     assert info.value.code == 2
-    assert "must be a finite number, not inf (a number past 1.8e308, such as 1e400, reads as inf)" in said
+    assert ("the DOF threshold must be a number of 0 or more, not `1e400` (past 1.8e308, the "
+            "largest number a float holds)") in said
 
 
 # ---- bounded fuzzing, every input kind -----------------------------------------------------------

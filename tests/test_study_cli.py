@@ -183,13 +183,18 @@ def test_an_output_that_is_a_file_is_refused_as_such(tiny, tmp_path, compare):
     (["TINY", "--or", "max,unbounded_sum"], 2, "did you mean `bounded_sum`"),
     (["TINY", "--planner", "potential"], 2, "did you mean `potential_field`"),
     (["TINY", "--scheduler", "tcp://x:1"], 2, "--scheduler needs --executor dask"),
+    # an empty address ran the study on this machine without a word, as if left out
+    (["TINY", "--scheduler", ""], 2, "'--scheduler': must name something, not be empty"),
+    (["TINY", "--executor", "dask", "--scheduler", " "], 2, "must name something, not be empty"),
     (["TINY", "--executor", "dsk"], 2, "did you mean `dask`"),
     (["TINY", "--behavior", "drve"], 1, "drive"),
     (["TINY", "TINY"], 2, "given twice"),
     (["TINY", "TINY_AGAIN"], 2, "given twice"),    # (another spelling: Study's exit 1)
     (["TINY", "--planner", "dwa", "--and", "product"], 2, "--and chooses the fuzzy planner's"),
-    (["TINY", "--runs", "1000000"], 2, "is not in the range 1<=x<=100000"),   # (no memory
-    (["TINY", "-n", "1000000"], 2, "is not in the range 1<=x<=100000"),       # for the tasks)
+    # an unknown planner is said as such, not as one without a fuzzy planner
+    (["TINY", "--planner", "dwaa", "--and", "product"], 2, "unknown planner `dwaa`"),
+    (["TINY", "--runs", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # (no
+    (["TINY", "-n", "1000000"], 2, "a whole number from 1 to 100000, not `1000000`"),  # memory)
 ])
 def test_user_errors(tiny, tmp_path, compare, args, code, words):
     again = str(Path(tiny).parent / ".." / Path(tiny).parent.name / "tiny.yaml")

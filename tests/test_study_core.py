@@ -1003,6 +1003,19 @@ def test_a_study_runs_world_paths_and_refuses_loaded_worlds(tmp_path):
         assert exc.value.hint == f"give its file: Study([{tiny.path!r}], ...)"
 
 
+@pytest.mark.parametrize("under", ["study", "a/study"])
+def test_an_output_directory_under_a_file_is_said_so(tmp_path, under):
+    """`compare -o notes.txt/study` said "`notes.txt` does not exist" and hinted `mkdir -p
+    notes.txt`, which fails: the file is in the way, and the message names it."""
+    (tmp_path / "notes.txt").write_text("x\n")
+    out = tmp_path / "notes.txt" / under
+    with pytest.raises(StudyError) as exc:
+        run_study(small_study(runs=1), out, workers=1, task_fn=fake_sim)
+    assert exc.value.message == (f"cannot create the output directory `{out}`: "
+                                 f"`{tmp_path / 'notes.txt'}` is a file, not a directory")
+    assert exc.value.hint == "choose another directory with -o"
+
+
 def test_an_output_directory_whose_parent_is_missing_is_refused(tmp_path):
     """`compare -o a/b/study` made every missing directory where `simulate --out`, `convert
     -o`, `export -o` and `plot -o` refuse a missing one: it makes the last one alone now, and

@@ -9,7 +9,7 @@ import typer
 
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import WORDS, finite, named
+from .params import WORDS, Number, named
 
 if TYPE_CHECKING:
     from ..engine.check import GridInfo, Report
@@ -132,10 +132,11 @@ def check_command(
         help="Check only this behavior, and the term sets' variables it reads or sets "
              "(default: every behavior and variable).")] = None,
     threshold: Annotated[float, typer.Option(
-        "--threshold", "-t", metavar="DOF", min=0.0, callback=finite,
+        "--threshold", "-t", metavar="DOF", click_type=Number("the DOF threshold", 0.0, whole=False),
         help="Report regions where the total DOF of an output's rules is below this.")] = 0.1,
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", metavar="N", min=2, max=10_000,
+        "--resolution", "-n", metavar="N",
+        click_type=Number("the number of grid points per input", 2, 10_000),
         help="Grid points per input (plus the terms' corners; lowered to keep the grid at "
              "most 300,000 samples).")] = 41,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,

@@ -12,7 +12,7 @@ from ..errors import UsageError, install_hint, unknown
 from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, WORDS, named, option_names
+from .params import MAX_RUNS, WORDS, Number, named, option_names
 from .progress import INTERRUPTED, progress_bar
 
 if TYPE_CHECKING:
@@ -24,6 +24,8 @@ if TYPE_CHECKING:
     from ..study.summary import Summary
 
 DEFAULT_AND = "min,product,lukasiewicz,einstein"
+#: ``--runs`` and its old spelling ``-n``
+RUNS = Number("the number of runs per world and choice", 1, MAX_RUNS)
 
 
 def compare_command(
@@ -45,13 +47,13 @@ def compare_command(
         "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
         help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
-        "--runs", metavar="N", min=1, max=MAX_RUNS,
+        "--runs", metavar="N", click_type=RUNS,
         help="Randomised runs per world and choice (a comparison needs many; `simulate` "
              "runs a world once as written unless given --runs).")] = 20,
     runs_n: Annotated[Optional[int], typer.Option(
-        "-n", min=1, max=MAX_RUNS, hidden=True, help="The old spelling of --runs.")] = None,
+        "-n", click_type=RUNS, hidden=True, help="The old spelling of --runs.")] = None,
     seed: Annotated[int, typer.Option(
-        "--seed", metavar="SEED", min=0,
+        "--seed", metavar="SEED", click_type=Number("the study's seed", 0),
         help="Seed of the whole study (runs are paired across choices).")] = 1,
     out: Annotated[str, typer.Option(
         "--out", "-o", metavar="DIR", callback=named,
@@ -61,11 +63,11 @@ def compare_command(
         "--executor", metavar="local|dask", autocompletion=complete.executors,
         help="local: a process pool on this machine; dask: dask.distributed.")] = "local",
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", "-j", metavar="N", min=1,
+        "--workers", "-j", metavar="N", click_type=Number("the number of processes", 1),
         help="Processes (local) or LocalCluster workers (dask). Default: the CPUs allowed, "
              "fewer where memory is short.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(
-        "--scheduler", metavar="ADDR",
+        "--scheduler", metavar="ADDR", callback=named,
         help="Dask scheduler address (tcp://host:8786); without it a LocalCluster.")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv "
@@ -168,11 +170,14 @@ def _planners(planner: str, and_: str, or_: str | None, inference: str | None, r
               behavior: str | None) -> list[str]:
     """``--planner``'s names; the fuzzy planner's options without it are refused (they were
     dropped without a word)."""
-    from ..study.spec import split_list
+    from ..study.spec import PLANNERS, split_list
 
     planners = split_list(planner)
     if not planners:
         raise typer.BadParameter("name at least one planner", param_hint="--planner")
+    for name in planners:           # before what the planners lack (`--planner dwaa --and min`
+        if name not in PLANNERS:    # said "--planner dwaa has no fuzzy planner")
+            raise unknown("planner", name, PLANNERS, cls=UsageError)
     for flag, names, what in (("--and", and_, "T-norm"), ("--or", or_, "S-norm"),
                               ("--inference", inference, "inference method")):
         if names is not None and not split_list(names):     # (`--and ,` ran the rule base's)

@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..numbers import exact
 from ..words import plural
 from .output import emit, json_text, warn, warn_notes
-from .params import WORDS, choice, choices, completer, named
+from .params import WORDS, Number, choice, choices, completer, named
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -207,7 +207,7 @@ def eval_command(
         help="Evaluate every row of a CSV whose header names the inputs; write a CSV of the "
              "inputs, the outputs and the CSV's other columns as they were.")] = None,
     digits: Annotated[Optional[int], typer.Option(
-        "--digits", metavar="N", min=0, max=12,
+        "--digits", metavar="N", click_type=Number("the number of decimals", 0, 12),
         help="Decimals in the trace (default 1, as the paper prints) and, with --batch, in the "
              "outputs (default: every digit, the shortest text that reads back as the same "
              "number).")] = None,

@@ -1,9 +1,11 @@
-"""Checks of option values that Typer's own ``min=``/``max=`` let through."""
+"""The types and checks of option values: numbers, names, files, choices, repeats."""
 
 from __future__ import annotations
 
 import math
 import os
+import re
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from enum import Enum
@@ -13,10 +15,11 @@ from typing import Any, TypeVar
 import typer
 from typer._click import Context, Parameter
 from typer._click.exceptions import NoSuchOption
-from typer._click.types import ParamType
+from typer._click.types import FloatRange, ParamType
 from typer.core import TyperCommand, TyperOption
 
-from ..errors import NameError_, UsageError, unknown
+from ..errors import NameError_, UsageError, unknown, visible
+from ..numbers import exact, parse_number
 
 E = TypeVar("E", bound=Enum)
 V = TypeVar("V", bound="str | list[str] | None")
@@ -28,14 +31,90 @@ V = TypeVar("V", bound="str | list[str] | None")
 MAX_RUNS = 100_000
 
 
-def finite(value: float | None) -> float | None:
-    """``nan`` passes ``min=0`` (every comparison with NaN is false): refuse it, and the
-    infinities, as usage errors (exit 2) instead of letting them turn a check off or reach
-    the code as a traceback. ``None`` (an option left out) passes."""
-    if value is not None and not math.isfinite(value):
-        past = "" if math.isnan(value) else " (a number past 1.8e308, such as 1e400, reads as inf)"
-        raise typer.BadParameter(f"must be a finite number, not {value}{past}")
-    return value
+class Number(FloatRange):
+    """The type of every option that takes a number: a ``whole`` one (a count, a seed) or
+    any finite one, from ``min`` to ``max`` (either may be left open). Anything else is a
+    usage error (exit 2) saying what the option means, what it takes and what was given
+    ("the number of grid points per input must be a whole number from 2 to 10000, not
+    `abc`"), where Click's range types said "'abc' is not a valid int range" or "0 is not in
+    the range x>=1", naming neither. (Typer's help still shows the range, ``[2<=x<=10000]``,
+    as for Click's own range types: this is one.)
+
+    Numbers are read as every file here reads them (:func:`~mitos_cli.numbers.parse_number`:
+    ASCII decimal, an optional exponent). Python's ``int`` and ``float`` also read ``1_0``
+    and ``١٠`` (Arabic-Indic digits) as 10, which ran without a word. ``nan`` passes any
+    range (every comparison with NaN is false) and an infinity turns a check off: both are
+    refused, and ``1e400`` is said as it was written, not as the ``inf`` it reads as."""
+
+    def __init__(self, what: str, min: float | None = None, max: float | None = None,
+                 whole: bool = True) -> None:
+        super().__init__(min=min, max=max)
+        self.what = what
+        self.whole = whole
+        self.name = "whole number" if whole else "number"
+
+    def convert(self, value: Any, param: Parameter | None, ctx: Context | None) -> Any:
+        if not isinstance(value, str):        # a default, or a value converted already
+            return value
+        number = self.read(value)
+        if number is None or (self.min is not None and number < self.min) \
+                or (self.max is not None and number > self.max):
+            self.fail(self.wrong(value), param, ctx)
+        return number
+
+    def read(self, text: str) -> int | float | None:
+        """``text`` as this option's number, or None (not a number it takes)."""
+        if self.whole:
+            try:
+                return int(text) if _WHOLE.fullmatch(text) else None
+            except ValueError:                  # past Python's 4,300 digits
+                return None
+        try:
+            x = parse_number(text)
+        except ValueError:
+            return None
+        return x if math.isfinite(x) else None
+
+    def wrong(self, text: str) -> str:
+        """What is wrong with ``text``, in words: the option's meaning, the numbers it
+        takes, what was given and, where it helps, how to write it."""
+        kind = "a whole number" if self.whole else "a number"
+        if self.min is not None and self.max is not None:
+            kind += f" from {exact(self.min)} to {exact(self.max)}"
+        elif self.min is not None:
+            kind += f" of {exact(self.min)} or more"
+        elif self.max is not None:
+            kind += f" of {exact(self.max)} or less"
+        if not text.strip():
+            given = "an empty value"
+        elif len(text) > 60:
+            given = f"`{visible(text[:20])}...{visible(text[-10:])}` ({len(text):,} characters)"
+        else:
+            given = f"`{visible(text)}`"
+        return f"{self.what} must be {kind}, not {given}{self.how(text)}"
+
+    def how(self, text: str) -> str:
+        """How to write ``text`` as a number this option takes, where that can be told."""
+        try:
+            x = parse_number(text)
+        except ValueError:
+            try:
+                float(text)                     # Python's reading: `1_0`, `١٠`
+            except ValueError:
+                return ""
+            return " (write it with the digits 0 to 9)"
+        if not self.whole and math.isinf(x) and "inf" not in text.lower():
+            return " (past 1.8e308, the largest number a float holds)"
+        if self.whole and abs(x) < 1e18 and x == int(x) and not _WHOLE.fullmatch(text):
+            return f" (write it in digits: {int(x)})"
+        most = getattr(sys, "get_int_max_str_digits", lambda: 0)()    # (0: no limit)
+        if self.whole and _WHOLE.fullmatch(text) and 0 < most < len(text.strip().lstrip("+-")):
+            return f": Python reads whole numbers of at most {most:,} digits"
+        return ""
+
+
+#: a whole number as an option takes it: ASCII digits, a sign, spaces around
+_WHOLE = re.compile(r"\s*[-+]?[0-9]+\s*", re.ASCII)
 
 
 def named(value: V) -> V:

@@ -17,13 +17,22 @@ from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ..errors import UsageError
-from ..numbers import parse_number
+from ..errors import InputError, UsageError
+from ..numbers import parse_value
 from .eval_cmd import parse_values, refuse_nan, split_args, unused_inputs
 from .help import epilog
 from .meant import MeantGroup
 from .output import emit, err, warn
-from .params import WORDS, OnceCommand, choice, choices, completer, named, not_a_directory_name
+from .params import (
+    WORDS,
+    Number,
+    OnceCommand,
+    choice,
+    choices,
+    completer,
+    named,
+    not_a_directory_name,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -58,6 +67,7 @@ def picture_path(path: Optional[str], option: str) -> Optional[str]:
     """The picture file an ``option`` names, a .png or .svg one (usage error otherwise)."""
     if path is None:
         return None
+    named(path)                        # (`-o ''` said "`` has no extension")
     suffix = Path(not_a_directory_name(path)).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise typer.BadParameter(
@@ -141,8 +151,9 @@ def _use_color(color: Optional[bool]) -> bool:
 
 
 #: the terminal drawing's options
+WIDTH = Number("the plot's width in characters", 30, 400)
 WidthOpt = Annotated[Optional[int], typer.Option(
-    "--width", metavar="N", min=30, max=400,
+    "--width", metavar="N", click_type=WIDTH,
     help="Terminal plot width in characters (default: the terminal's, at most 100).")]
 ColorOpt = Annotated[Optional[bool], typer.Option(
     "--color/--no-color", help="Colour the terminal plot (default: when stdout is a "
@@ -160,12 +171,13 @@ def _terminal_width(width: Optional[int]) -> int:
 
 def terms_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] [NAME=VALUE]...",
+        click_type=WORDS, metavar="[RULEBASE] [NAME=VALUE]...", callback=named,
         help="Rule file (default: the packaged MITOS rule base) or a term set "
              "(FILE.terms.yaml), then values to mark, "
              "e.g. road=78.")] = None,
     var: Annotated[Optional[list[str]], typer.Option(
-        "--var", "-v", metavar="NAME", help="Draw only this variable (repeat for more).")] = None,
+        "--var", "-v", metavar="NAME", callback=named,
+        help="Draw only this variable (repeat for more).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,
         help="Draw only the variables this behavior uses.")] = None,
@@ -246,10 +258,25 @@ def _axis(text: str, option: str) -> tuple[str, Optional[tuple[float, float]]]:
     try:
         if not colon:
             raise ValueError
-        return name, (parse_number(lo), parse_number(hi))
+        return name, (parse_value(lo), parse_value(hi))
+    except OverflowError:           # (`1e400` read as inf was said as `inf`, never written)
+        big = next(t for t in (lo, hi) if not _fits(t))
+        raise InputError(f"range {rng} of `{name}` has a number too large for a float: `{big}`",
+                         expected="numbers of magnitude at most 1.8e308") from None
     except ValueError:
         raise typer.BadParameter(f"`{text}`: write NAME or NAME=LOW:HIGH, e.g. {name}=40:100",
                                  param_hint=option) from None
+
+
+def _fits(text: str) -> bool:
+    """Whether ``text`` reads as a number inside a float's range (or as written, ``inf``)."""
+    try:
+        parse_value(text)
+    except OverflowError:
+        return False
+    except ValueError:
+        pass
+    return True
 
 
 def _fixed(items: list[str]) -> dict[str, str]:
@@ -291,9 +318,10 @@ STYLE_NEEDS = ("--style chooses how a picture of two inputs is drawn: add --y an
 
 
 def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
-                      y: str | None) -> tuple[str, str, str | None]:
+                      y: str | None) -> tuple[str, str, str | None, list[str]]:
     """What `mitos plot surface` draws when told less, as MATLAB's ``gensurf(fis)``: the
-    behavior's first output over its first two inputs, each default said in a note."""
+    behavior's first output over its first two inputs, and the note that says each default
+    (printed once the surface is made: before an error it spoke of a drawing never made)."""
     chose = []
     if out_name is None:
         out_name = rb.outputs[0]
@@ -304,29 +332,29 @@ def _surface_defaults(rb: LoadedRuleBase, out_name: str | None, x: str | None,
         x, y = rb.inputs[0], rb.inputs[1] if len(rb.inputs) > 1 else None
         over = f"`{x}`" + (f" and `{y}`" if y is not None else "")
         chose.append(f"over {over}, the first inputs (--x and --y choose others)")
-    if chose:
-        err("note: drawing " + "; ".join(chose))
-    return out_name, x, y
+    return out_name, x, y, ["drawing " + "; ".join(chose)] if chose else []
 
 
 def surface_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] [OUTPUT]",
+        click_type=WORDS, metavar="[RULEBASE] [OUTPUT]", callback=named,
         help="Rule file (default: the packaged MITOS rule base), then the output to draw "
              "(default: the behavior's first, with a note).")] = None,
     x: Annotated[Optional[str], typer.Option(
-        "--x", metavar="INPUT[=LOW:HIGH]",
+        "--x", metavar="INPUT[=LOW:HIGH]", callback=named,
         help="Input on the x axis, optionally zoomed to LOW:HIGH (default: the behavior's "
              "first input, and its second on the y axis, as MATLAB's gensurf).")] = None,
     y: Annotated[Optional[str], typer.Option(
-        "--y", metavar="INPUT[=LOW:HIGH]",
+        "--y", metavar="INPUT[=LOW:HIGH]", callback=named,
         help="Input on the y axis (with --x alone: a curve over --x).")] = None,
     fix: Annotated[Optional[list[str]], typer.Option(
         "--fix", metavar="NAME=VALUE",
         help="Hold another input at a value (repeat; inputs not fixed are held at the "
              "midpoint of their universe, with a note).")] = None,
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", metavar="N", min=2, max=1000, help="Grid points per axis.")] = 61,
+        "--resolution", "-n", metavar="N",
+        click_type=Number("the number of grid points per axis", 2, 1000),
+        help="Grid points per axis.")] = 61,
     style_name: Annotated[Optional[str], typer.Option(
         "--style", metavar=choices(Style), autocompletion=completer(Style),
         help="surface: a 3-D surface (the default); heatmap: a heat map with contour lines. "
@@ -351,15 +379,16 @@ def surface_command(
                                    or not _wants_picture(output, show)):
         raise typer.BadParameter(STYLE_NEEDS)
     path, out_name = _surface_args(args or [])
+    held = _fixed(fix or [])            # (a malformed --fix followed a note on the axes)
     rb = load_rulebase(path, behavior)
-    out_name, x, y = _surface_defaults(rb, out_name, x, y)
+    out_name, x, y, chosen = _surface_defaults(rb, out_name, x, y)
     if style_name is not None and y is None:          # a behavior of one input: a curve
         raise typer.BadParameter(STYLE_NEEDS)
     x_name, x_range = _axis(x, "'--x'")
     y_name, y_range = _axis(y, "'--y'") if y is not None else (None, None)
-    fixed = parse_values(_fixed(fix or []))
+    fixed = parse_values(held)
     s = surface(rb.compiled, out_name, x_name, y_name, fixed, resolution, x_range, y_range)
-    for note in s.notes():
+    for note in [*chosen, *s.notes()]:
         err(f"note: {note}")
     if not _wants_picture(output, show):
         from ..draw.terminal import render_surface
@@ -385,7 +414,7 @@ def _used_values(rb: LoadedRuleBase, texts: dict[str, str]) -> dict[str, float]:
 
 def rules_command(
     args: Annotated[Optional[list[str]], typer.Argument(
-        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...",
+        click_type=WORDS, metavar="[RULEBASE] NAME=VALUE...", callback=named,
         help="Rule file (default: the packaged MITOS rule base), then one NAME=VALUE per "
              "input.")] = None,
     output: OutputOpt = None,
@@ -393,10 +422,10 @@ def rules_command(
     title: TitleOpt = None,
     behavior: BehaviorOpt = None,
     max_rules: Annotated[int, typer.Option(
-        "--max-rules", metavar="N", min=1, max=500,
+        "--max-rules", metavar="N", click_type=Number("the number of fired rules to draw", 1, 500),
         help="Draw at most this many fired rules (the strongest).")] = 30,
     width: Annotated[Optional[int], typer.Option(
-        "--width", metavar="N", min=30, max=400,
+        "--width", metavar="N", click_type=WIDTH,
         help="Width in characters of a Mamdani output's plot in the text viewer "
              "(default 72).")] = None,
     color: ColorOpt = None,

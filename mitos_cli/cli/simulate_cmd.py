@@ -11,7 +11,7 @@ import typer
 from ..words import clearance, percent, plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, WORDS, file_arg, finite, named, option_names
+from .params import MAX_RUNS, WORDS, Number, file_arg, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
@@ -210,10 +210,11 @@ def simulate_command(
         "--behavior", "-b", metavar="NAME", callback=named,
         help="Behavior that drives (default: the world's, else `drive`).")] = None,
     seed: Annotated[Optional[int], typer.Option(
-        "--seed", metavar="SEED", min=0,
+        "--seed", metavar="SEED", click_type=Number("the seed", 0),
         help="Seed (default: the world's); with --runs, run j uses SEED+j.")] = None,
     runs: Annotated[int, typer.Option(
-        "--runs", metavar="N", min=0, max=MAX_RUNS,
+        "--runs", metavar="N",
+        click_type=Number("the number of randomised runs per world", 0, MAX_RUNS),
         help="Randomised runs per world (obstacle places, sensor noise); 0: the world once, "
              "as written (`compare` defaults to 20: it needs many).")] = 0,
     randomise: Annotated[bool, typer.Option(
@@ -230,7 +231,8 @@ def simulate_command(
                         "planner that is not a rule base); of the first robot where there are "
                         "several; on stderr with --json, which keeps stdout for the JSON.")] = False,
     every: Annotated[Optional[int], typer.Option(
-        "--every", metavar="N", min=1, help="Ticks between traces (default 20); with --trace.")] = None,
+        "--every", metavar="N", click_type=Number("the number of ticks between traces", 1),
+        help="Ticks between traces (default 20); with --trace.")] = None,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", parser=file_arg, metavar="FILE.png|FILE.svg",
         help="Draw the run (world, obstacles, path); with --runs, every run's path in one "
@@ -238,7 +240,7 @@ def simulate_command(
     live: Annotated[bool, typer.Option(
         "--live", help="Show a terminal view on stderr while it runs, paced by --speed.")] = False,
     speed: Annotated[Optional[float], typer.Option(
-        "--speed", min=0.0, metavar="X", callback=finite,
+        "--speed", metavar="X", click_type=Number("the real-time factor", 0.0, whole=False),
         help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
              "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(
@@ -246,13 +248,14 @@ def simulate_command(
         help="Write the run as an animation: map, footprint, sonar cones, trail, obstacles, "
              "time and the fired rules' DOFs (.mp4 needs ffmpeg).")] = None,
     fps: Annotated[Optional[float], typer.Option(
-        "--fps", metavar="FPS", min=0.1, max=60.0, callback=finite,
+        "--fps", metavar="FPS",
+        click_type=Number("the frames per second", 0.1, 60.0, whole=False),
         help="Animation frames per second of simulated time (plays in real time; default 10); "
              "with --animate.")] = None,
     require: Annotated[Optional[str], typer.Option(
         "--require", metavar="success", help="Exit 3 unless every run ends in this outcome.")] = None,
     workers: Annotated[Optional[int], typer.Option(
-        "--workers", "-j", metavar="N", min=1,
+        "--workers", "-j", metavar="N", click_type=Number("the number of processes", 1),
         help="Processes for --runs (default: the CPUs allowed, fewer where memory is short).")] = None,
     planner_name: Annotated[str, typer.Option(
         "--planner", metavar="NAME", autocompletion=complete.planners,

@@ -69,7 +69,7 @@ def teach_command(
         "--resume", help="Continue the last teaching session here (or --session NAME) from "
                          "its journal.")] = False,
     session_name: Annotated[str | None, typer.Option(
-        "--session", metavar="NAME", help="The session to resume (a name under "
+        "--session", metavar="NAME", callback=named, help="The session to resume (a name under "
                                           ".mitos/teach/).")] = None,
     recover: Annotated[bool, typer.Option(
         "--recover", help="With --resume: keep the changes before a damaged line of the "

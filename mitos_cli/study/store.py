@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..errors import MitosError, Span, did_you_mean
-from ..fileio import bad_byte, read_text, unreadable
+from ..fileio import bad_byte, file_in_the_way, read_text, unreadable
 from ..resources import is_file
 from ..words import plural
 from .spec import KEY_FIELDS, Task
@@ -350,6 +350,13 @@ class ResultStore:
                              "leave out --resume to start a study there")
         parent = self.dir.parent
         if not there and not parent.is_dir():
+            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
+            # `mkdir -p notes.txt` were no help
+            found = file_in_the_way(parent)
+            if found is not None:
+                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
+                                 f"is a file, not a directory",
+                                 hint="choose another directory with -o")
             # the directory alone is made, as every other writer makes only its file: a
             # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
             raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
