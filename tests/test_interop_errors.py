@@ -343,6 +343,102 @@ def test_fcl_keywords_as_fcl_writes_them(old: str, new: str, at: str, hint: str 
     assert caret.strip() == "^" * len(at)
 
 
+# A keyword glued to the next word: Lark's contextual lexer took the keyword off the front of
+# the word where only a keyword could stand, and read `ISgood` as `IS good`, `WITH0.8` as `WITH
+# 0.8`; jFuzzyLogic's lexer reads the word as one identifier and refuses it. It is said at the
+# word, with what could stand there.
+@pytest.mark.parametrize("old, new, word, expected, hint", [
+    ("IF service IS good", "IF service ISgood", "ISgood", "one of AND, IS, OR, THEN",
+     "`IS` and `good` are two words: `IS good`"),
+    ("IS good THEN tip", "IS good THENtip", "THENtip", "one of AND, OR, THEN",
+     "`THEN` and `tip` are two words: `THEN tip`"),
+    ("RULE 2 : IF service", "RULE 2 : IFservice", "IFservice", "one of IF",
+     "`IF` and `service` are two words: `IF service`"),
+    ("IS poor OR food", "IS poor ORfood", "ORfood", "one of AND, OR, THEN",
+     "`OR` and `food` are two words: `OR food`"),
+    ("IS excellent AND food", "IS excellent ANDfood", "ANDfood", "one of AND, OR, THEN",
+     "`AND` and `food` are two words: `AND food`"),
+    ("IF NOT (", "IFNOT (", "IFNOT", "one of IF", "`IF` and `NOT` are two words: `IF NOT`"),
+    ("service IS NOT excellent", "service ISNOT excellent", "ISNOT", "one of AND, IS, OR, THEN",
+     "`IS` and `NOT` are two words: `IS NOT`"),
+    ("WITH 0.8", "WITH0.8", "WITH0.8",
+     "one of AND, END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE, WITH, `,`, `;`",
+     "`WITH` and `0.8` are two words: `WITH 0.8`"),
+    ("RULE 2 :", "RULE2 :", "RULE2", "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE",
+     "`RULE` and `2` are two words: `RULE 2`"),
+    ("TERM poor", "TERMpoor", "TERMpoor", "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, "
+     "TERM", "`TERM` and `poor` are two words: `TERM poor`"),
+    ("FUZZIFY food", "FUZZIFYfood", "FUZZIFYfood", "one of DEFUZZIFY, END_FUNCTION_BLOCK, "
+     "FUZZIFY, RULEBLOCK, VAR_INPUT, VAR_OUTPUT", "`FUZZIFY` and `food` are two words: "
+     "`FUZZIFY food`"),
+    ("RULEBLOCK No1", "RULEBLOCKNo1", "RULEBLOCKNo1", "one of DEFUZZIFY, END_FUNCTION_BLOCK, "
+     "FUZZIFY, RULEBLOCK, VAR_INPUT, VAR_OUTPUT", "`RULEBLOCK` and `No1` are two words: "
+     "`RULEBLOCK No1`"),
+    ("FUNCTION_BLOCK tipper", "FUNCTION_BLOCKtipper", "FUNCTION_BLOCKtipper",
+     "one of FUNCTION_BLOCK", "`FUNCTION_BLOCK` and `tipper` are two words: "
+     "`FUNCTION_BLOCK tipper`"),
+    ("END_FUZZIFY\n\nDEFUZZIFY", "END_FUZZIFYDEFUZZIFY", "END_FUZZIFYDEFUZZIFY",
+     "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, TERM",
+     "`END_FUZZIFY` and `DEFUZZIFY` are two words: `END_FUZZIFY DEFUZZIFY`"),
+    ("END_RULEBLOCK\n\nEND_FUNCTION_BLOCK", "END_RULEBLOCKEND_FUNCTION_BLOCK",
+     "END_RULEBLOCKEND_FUNCTION_BLOCK", "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE",
+     "`END_RULEBLOCK` and `END_FUNCTION_BLOCK` are two words: "
+     "`END_RULEBLOCK END_FUNCTION_BLOCK`"),
+    # what follows is no word that may follow the keyword: the keyword misspelt
+    ("END_RULEBLOCK", "END_RULEBLOCKx", "END_RULEBLOCKx",
+     "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE", "did you mean `END_RULEBLOCK`?"),
+    # numbers glued: `10x` was `10` and a parameter named `x`, `5.5.5` was 5.5 and 0.5
+    ("trian 0 5 10", "trian 0 5 10x", "10x", "one of `;`, a name, a number, inf, nan", None),
+    ("trian 0 5 10", "trian 0 5.5.5", "5.5.5", "one of `;`, a name, a number, inf, nan", None),
+])
+def test_fcl_a_keyword_glued_to_the_next_word_is_refused_at_the_word(
+        old: str, new: str, word: str, expected: str, hint: str | None) -> None:
+    assert old in FCL, old
+    text = FCL.replace(old, new, 1)
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text, "bad.fcl")
+    exc = info.value
+    assert (exc.message, exc.expected, exc.hint) == (f"unexpected `{word}`", expected, hint)
+    line = text.splitlines()[exc.span.line - 1]
+    assert line[exc.span.column - 1:].startswith(word)
+    assert exc.render().splitlines()[2].strip() == "^" * len(word)
+
+
+def test_fcl_a_glued_keyword_in_fuzzylites_dialect_is_said_in_full() -> None:
+    text = (Path(__file__).parent / "data" / "interop" / "dimmer_fuzzylite.fcl").read_text()
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text.replace("if Ambient is DARK", "if Ambient isDARK"), "dimmer.fcl")
+    assert info.value.render() == (
+        "dimmer.fcl:32:21: format error: unexpected `isDARK`\n"
+        "    RULE 1 : if Ambient isDARK then Power is HIGH\n"
+        "                        ^^^^^^\n"
+        "expected one of AND, IS, OR, THEN\n"
+        "hint: `is` and `DARK` are two words: `is DARK`")
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text.replace("with 0.5", "with0.5"), "dimmer.fcl")
+    assert info.value.message == "unexpected `with0.5`"
+
+
+@pytest.mark.parametrize("old, new, at, hint", [
+    # a word that ends in a keyword the parser expects next is one name (as jFuzzyLogic reads
+    # it): the error comes at the word after it, and says why
+    ("IS poor OR food", "IS poorOR food", "food", "`poorOR` is read as one name: `poor` and "
+     "`OR` are two words"),
+    ("IS rancid THEN tip IS cheap", "IS rancidTHEN tip IS cheap", "tip", "`rancidTHEN` is "
+     "read as one name: `rancid` and `THEN` are two words"),
+    ("\tservice : REAL;", "\tservice : REALRANGE := (0 .. 10);", ":=", "`REALRANGE` is read "
+     "as one name: `REAL` and `RANGE` are two words"),
+    ("END_VAR\n\nVAR_OUTPUT", "END_VARVAR_OUTPUT", "tip", "`END_VARVAR_OUTPUT` is read as "
+     "one name: `END_VAR` and `VAR_OUTPUT` are two words"),
+])
+def test_fcl_a_name_glued_to_a_keyword_is_named_in_the_hint(old: str, new: str, at: str,
+                                                            hint: str) -> None:
+    assert old in FCL, old
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace(old, new, 1), "bad.fcl")
+    assert (info.value.message, info.value.hint) == (f"unexpected `{at}`", hint)
+
+
 def test_fcl_punctuation_is_quoted() -> None:
     with pytest.raises(FormatError) as info:
         parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")
