@@ -131,6 +131,51 @@ def test_fll_errors(old: str, new: str, words: str) -> None:
     assert span is not None and span.path == "bad.fll" and span.line >= 1
 
 
+# A rule's keyword glued to the next word: the contextual lexer took it off the word's front
+# (`a islow` was `a is low`); fuzzylite splits a rule at its blanks and refuses the word.
+@pytest.mark.parametrize("old, new, word, expected, hint", [
+    ("if a is low and", "if a islow and", "islow", "one of is",
+     "`is` and `low` are two words: `is low`"),
+    ("is small then y", "is small theny", "theny", "one of and, or, then",
+     "`then` and `y` are two words: `then y`"),
+    ("is on with 0.5", "is on with0.5", "with0.5", "one of and, the end of the rule, with",
+     "`with` and `0.5` are two words: `with 0.5`"),
+    ("rule: if a is low", "rule: ifa is low", "ifa", "one of if",
+     "`if` and `a` are two words: `if a`"),
+    ("is low and b", "is low andb", "andb", "one of and, or, then",
+     "`and` and `b` are two words: `and b`"),
+    ("is high or b", "is high orb", "orb", "one of and, or, then",
+     "`or` and `b` are two words: `or b`"),
+    ("if a is low and", "if a isvery low and", "isvery", "one of is",
+     "`is` and `very` are two words: `is very`"),
+    ("with 0.5", "with 0.5x", "0.5x", "one of a number", None),
+])
+def test_fll_a_keyword_glued_to_the_next_word_is_refused_at_the_word(
+        old: str, new: str, word: str, expected: str, hint: str | None) -> None:
+    text = fll(old, new)
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "bad.fll")
+    exc = info.value
+    assert (exc.message, exc.expected, exc.hint) == (f"unexpected `{word}`", expected, hint)
+    line = text.splitlines()[exc.span.line - 1]
+    assert line[exc.span.column - 1:].startswith(word)
+    assert exc.render().splitlines()[2].strip() == "^" * len(word)
+
+
+def test_fll_a_term_glued_to_a_keyword_is_named_in_the_hint() -> None:
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("then y is on with 0.5", "then y is onwith 0.5"), "bad.fll")
+    assert info.value.render() == (
+        "bad.fll:26:51: format error: cannot read this rule\n"
+        "      rule: if a is high or b is big then y is onwith 0.5\n"
+        "                                                      ^\n"
+        "expected one of and, the end of the rule, with\n"
+        "hint: `onwith` is read as one name: `on` and `with` are two words")
+    with pytest.raises(FormatError) as info:       # the end of the rule said after it
+        parse_fll(fll("then y is on with 0.5", "then y is on with"), "bad.fll")
+    assert (info.value.span.column, info.value.expected) == (51, "one of a number")
+
+
 def test_fll_error_points_at_the_line() -> None:
     text = fll("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5")
     with pytest.raises(FormatError) as info:

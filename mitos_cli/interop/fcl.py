@@ -56,6 +56,7 @@ from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
 from .fclfunction import linear_function
+from .lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from .ruletree import check_depth, conclusions, expression
 from .text import read_foreign_file
 
@@ -94,11 +95,10 @@ def read_fcl(path: str | Path) -> RuleBase:
     return read_foreign_file(Path(path), parse_fcl)
 
 
-def _syntax_error(exc: UnexpectedInput, text: str, path: str | None,
-                  before: Token | None = None) -> FormatError:
+def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:
     """Lark's exception in FCL's own words: keywords as FCL writes them (``END_FUZZIFY``),
     "did you mean" for a word that is a misspelt keyword (``TREM``, ``END_FUZIFY``), and
-    "two words" for the word ``before`` the error read as one name (``poorTHEN``)."""
+    "two words" for the word before the error read as one name (``poorTHEN``)."""
     line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
     end_column = None
     hint = None
@@ -115,8 +115,11 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None,
             expected = set(exc.interactive_parser.accepts()) or expected
         if exc.token.type == "NAME":                # a word where a keyword stands
             hint = did_you_mean(str(exc.token), _keywords(expected))
+        before = (exc.token_history or [None])[-1]
         if hint is None and before is not None and before.type == "NAME":
-            hint = _two_words_in(str(before), set(_keywords(expected)))
+            hint = read_as_one_name(str(before), set(_keywords(expected)),
+                                    set(_keywords(t.name for t in parser().terminals)),
+                                    fold=str.upper)
     elif isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
@@ -125,21 +128,6 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None,
         what = "cannot read this"
     return FormatError(what, span=Span.in_text(text, path, line, column, end_column),
                        expected=_expected(expected), hint=hint)
-
-
-def _two_words_in(name: str, expected: set[str]) -> str | None:
-    """A hint for a name that is a word glued to a keyword the parser expects after it
-    (``poorTHEN``, ``REALRANGE``), or two keywords glued (``END_VARVAR_OUTPUT``): the lexer
-    read it as one name, as jFuzzyLogic does, and the error came at the word after it."""
-    keywords = set(_keywords(t.name for t in parser().terminals))
-    upper = name.upper()
-    for keyword in sorted(keywords, key=len, reverse=True):
-        cut = len(name) - len(keyword)
-        if cut > 0 and upper.endswith(keyword) and (keyword in expected or
-                                                    upper[:cut] in keywords):
-            return (f"`{name}` is read as one name: `{name[:cut]}` and `{name[cut:]}` are two "
-                    f"words")
-    return None
 
 
 #: option keys (one terminal, OPTION_KEY) as FCL writes them
@@ -181,63 +169,28 @@ def _word(terminal: str) -> str:
     return literal if literal.replace("_", "").isalpha() else f"`{literal}`"
 
 
-#: what a word is made of (jFuzzyLogic's ``ID``, keywords and numbers): two tokens that touch
-#: with these on both sides were cut out of one word
-_WORD_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_")
-
-
-def _one_word(first: Token, second: Token) -> bool:
-    """Whether the lexer cut ``first`` and ``second`` out of one word (``IS`` and ``lo`` out of
-    ``ISlo``, ``WITH`` and ``0.5`` out of ``WITH0.5``, ``0.5`` and ``.5`` out of ``0.5.5``)."""
-    if first.end_pos != second.start_pos:       # the usual case: a blank or a comment between
-        return False
-    b = str(second)
-    return str(first)[-1:] in _WORD_CHARS and \
-        (b[:1] in _WORD_CHARS or (b[:1] == "." and b[1:2].isdigit()))
-
-
 def _parse(text: str, path: str | None) -> Tree:
-    """``text``'s parse tree, or its syntax error; a keyword glued to the next word is
-    refused.
-
-    Where the grammar allows a keyword alone, Lark's contextual lexer takes the keyword off the
-    front of a longer word and reads the rest as the next token: ``IF dist ISlo`` was read as
-    ``IS lo``, ``WITH0.5`` as ``WITH 0.5``, ``END_FUZZIFYDEFUZZIFY`` as two keywords.
-    jFuzzyLogic's lexer (ANTLR's, the longest match) reads each as one identifier and refuses
-    it where a keyword stands; so does this reader, at the word."""
-    interactive = parser().parse_interactive(text)
-    last: Token | None = None
+    """``text``'s parse tree, or its syntax error; a keyword glued to the next word
+    (``IF dist ISlo``, ``WITH0.5``) is refused at the word, as jFuzzyLogic refuses it."""
     try:
-        for token in interactive.iter_parse():
-            if last is not None and _one_word(last, token):
-                raise _glued_error(last, token, text, path, set(interactive.accepts()))
-            last = token
-        return interactive.feed_eof(last)
-    except UnexpectedToken as exc:
-        if last is not None and exc.token.type != "$END" and _one_word(last, exc.token):
-            # `END_RULEBLOCKx`: a word the parser refused after the keyword
-            raise _glued_error(last, exc.token, text, path, set()) from None
-        if exc.interactive_parser is None:      # set by Lark's parse(), not by feed_token()
-            exc.interactive_parser = interactive
-        raise _syntax_error(exc, text, path, last) from None
+        return parse_apart(parser(), text)
+    except Glued as glued:
+        raise _glued_error(glued, text, path) from None
     except UnexpectedInput as exc:
         raise _syntax_error(exc, text, path) from None
 
 
-def _glued_error(first: Token, second: Token, text: str, path: str | None,
-                 after_first: set[str]) -> FormatError:
-    """``first`` and ``second``, one word in the file, said as the word: what could stand
-    there, and "two words" when a keyword was glued to what may follow it (``ISlo``), or
-    "did you mean" the keyword when nothing else fits (``END_RULEBLOCKx``)."""
+def _glued_error(glued: Glued, text: str, path: str | None) -> FormatError:
+    """A keyword glued to the next word (``ISlo``) said at the word: what could stand there,
+    and "two words" when what follows the keyword may follow it, else "did you mean" the
+    keyword (``END_RULEBLOCKx``)."""
+    first, second = glued.first, glued.second
     word = text[first.start_pos:second.end_pos]
-    before = parser().parse_interactive(text[:first.start_pos])
-    for _ in before.iter_parse():
-        pass
-    expected = set(before.accepts())
+    expected = accepted_before(parser(), text, first)
     keyword = first.type == "OPTION_KEY" or (_literal(first.type) or "1").replace("_", "")\
         .isalpha()
     hint = None
-    if keyword and second.type in after_first:
+    if keyword and glued.fits:
         hint = f"`{first}` and `{second}` are two words: `{first} {second}`"
     elif keyword:
         hint = did_you_mean(word, _keywords(expected))
