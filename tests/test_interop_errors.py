@@ -176,6 +176,16 @@ def test_fll_a_term_glued_to_a_keyword_is_named_in_the_hint() -> None:
     assert (info.value.span.column, info.value.expected) == (51, "one of a number")
 
 
+def test_fll_a_term_name_glued_to_its_type_is_named_in_the_hint() -> None:
+    """`term: lowTriangle 0 2 5` took `lowTriangle` for the name and `0` for the type, with no
+    word on why."""
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("term: low Triangle 0 2 5", "term: lowTriangle 0 2 5"), "bad.fll")
+    assert (info.value.message, info.value.hint) == (
+        "term `lowTriangle`: unknown term type `0`",
+        "`lowTriangle` is read as the term's name: `low` and `Triangle` are two words")
+
+
 def test_fll_error_points_at_the_line() -> None:
     text = fll("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5")
     with pytest.raises(FormatError) as info:

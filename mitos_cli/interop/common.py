@@ -251,9 +251,12 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           f"supported", span=span,
                           hint="replace it by one of the shapes: " + ", ".join(FUZZYLITE_SHAPES))
     if kind not in FUZZYLITE_SHAPES:
+        glued = [k for k in FUZZYLITE_SHAPES if name.endswith(k) and len(name) > len(k)]
+        hint = did_you_mean(kind, FUZZYLITE_SHAPES) or (
+            f"`{name}` is read as the term's name: `{name[:-len(glued[0])]}` and `{glued[0]}` "
+            f"are two words" if glued else None)        # `term: lowTriangle 0 1 2`
         raise FormatError(f"term `{name}`: unknown term type `{kind}`", span=span,
-                          expected="one of " + ", ".join(FUZZYLITE_SHAPES),
-                          hint=did_you_mean(kind, FUZZYLITE_SHAPES))
+                          expected="one of " + ", ".join(FUZZYLITE_SHAPES), hint=hint)
     shape, count = FUZZYLITE_SHAPES[kind]
     height = 1.0
     if shape == "linear":
