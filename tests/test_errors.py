@@ -80,8 +80,10 @@ def caret_under(exc: MitosError) -> str:
     ("r1: if road is WIDE then speed is", 34, None, "unexpected end of the input", "a name",
      None),
     ("r1: if (road is WIDE then speed is SLOW", 22, "then", "unexpected `then`", "`)`", None),
-    ("r1: iff road is WIDE then speed is SLOW", 9, "road", "unexpected `road`", "`is`",
-     "`iff` is read as a variable's name: did you mean `if`?"),
+    # (until 2026-12-07 read as `if f`, then "unexpected `road`": the lexer took `if` off
+    # the front of `iff` where only `if` may stand)
+    ("r1: iff road is WIDE then speed is SLOW", 5, "iff", "unexpected `iff`", "`if`",
+     "did you mean `if`?"),
     ("r1: if road is WIDE thn speed is SLOW", 21, "thn", "unexpected `thn`", "`then`",
      "did you mean `then`?"),
     # `=` for `is`, and FCL's `;` at a rule's end: said how a rule file writes them
@@ -159,6 +161,14 @@ def caret_under(exc: MitosError) -> str:
      'did you mean `is`?'),
     ('r1: if (road is WIDE) and size isvery SMALL_SZ then speed is SLOW', 32, 'isvery',
      'unexpected `isvery`', '`is`', '`is` and `very` are two words: `size is very`'),
+    # every keyword is a word of its own: where only `if` may stand (after a label), `ifroad`
+    # was read as `if road` without a word
+    ('r1: ifroad is WIDE then speed is SLOW', 5, 'ifroad', 'unexpected `ifroad`', '`if`',
+     '`if` and `road` are two words: `if road`'),
+    ('r1: ifnot road is WIDE then speed is SLOW', 5, 'ifnot', 'unexpected `ifnot`', '`if`',
+     '`if` and `not` are two words: `if not`'),
+    ('r1: ifff road is WIDE then speed is SLOW', 5, 'ifff', 'unexpected `ifff`', '`if`',
+     'did you mean `if`?'),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)

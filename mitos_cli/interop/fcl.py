@@ -50,13 +50,13 @@ from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
+from ..lang.lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from ..lang.model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase, format_consequent
 from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
 from . import common
 from .common import FCL, FLL, fmt_number
 from .fclfunction import linear_function
-from .lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from .ruletree import check_depth, conclusions, expression
 from .text import read_foreign_file
 

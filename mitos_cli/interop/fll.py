@@ -38,12 +38,12 @@ from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
+from ..lang.lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from ..lang.model import Rule, RuleBase, Setting
 from ..lang.model import format_number as _fmt_weight
 from ..lang.terms import Role, Term, Variable
 from . import common
 from .common import FLL, Settings, fmt_number
-from .lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from .ruletree import conclusions as conclusions_of
 from .ruletree import expression
 from .text import read_foreign_file

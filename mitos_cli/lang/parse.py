@@ -29,6 +29,7 @@ from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
 from .cache import lark_parser
+from .lexing import Glued, accepted_before, one_word, parse_apart
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, Setting, Use
 
 if TYPE_CHECKING:
@@ -662,19 +663,71 @@ MAX_NESTING = 100
 
 def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:
     try:
-        tree = parser().parse(text, start=start)
+        tree = parse_apart(parser(), text, start=start,
+                           apart=lambda a, b: keyword_glued(a, b, parser()))
+    except Glued as glued:
+        raise glued_error(glued, text, path, parser(), start) from None
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
     check_nesting(tree, text, path)
     check_modifiers(tree, text, path)
-    check_glued_is(tree, text, path)
     return tree
 
 
-#: `is` at the start of a longer word (`road isWIDE`): where only `is` may follow a variable's
-#: name, the lexer takes the keyword off the front of the word and reads the rest as the next
-#: word (`isWIDE` was `is WIDE`, `iss WIDE` the term `s` and then an error at `WIDE`)
-_GLUED_IS = re.compile(r"(?<![\w-])is\w")
+def glued_error(glued: Glued, text: str, path: str | None, parser: Lark, start: str,
+                words: Callable[[Iterable[str]], str | None] | None = None
+                ) -> RuleSyntaxError:
+    """A keyword glued to the word after it (``r1: ifroad is ...``, ``with0.5``, ``adapt
+    epochs50``), which the lexer read as the keyword and the word: said at the word, with what
+    could stand there (``words`` names the terminals) and "two words" (``road isWIDE`` as
+    `_glued_is_error` says it), or "did you mean" the keyword (``iff``, ``thenn``)."""
+    first, second = glued.first, glued.second
+    start_pos, end_pos = first.start_pos or 0, second.end_pos or 0
+    word = text[start_pos:end_pos]
+    # `iff`, `iss`, `ifff`: a keyword and a letter, or its last letter again, is misspelt
+    typo = str(second).isalpha() and (len(str(second)) == 1 or
+                                      set(str(second).lower()) == {str(first)[-1:].lower()})
+    if first.type == "IS" and glued.fits:
+        var = re.search(r"([A-Za-z_][\w\-]*)\s*$", text[:start_pos])
+        return _glued_is_error(text, path, var.group(1) if var else "x", start_pos, end_pos,
+                               None if typo else str(second))
+    expected = accepted_before(parser, text, first, start)
+    keywords = [e.lower() for e in expected if e.isupper() and e.isalpha() and e != "NAME"]
+    said = next((k for k in keywords if word.startswith(k) and len(word) > len(k)), None)
+    hint = None
+    if typo:
+        hint = did_you_mean(word, keywords)
+    elif glued.fits and (_keyword(parser, first) or _keyword(parser, second)):
+        hint = f"`{first}` and `{second}` are two words: `{first} {second}`"
+    elif said is not None:          # `with0.5`: the name `with0`, then `.5`
+        hint = f"`{said}` and `{word[len(said):]}` are two words: `{said} {word[len(said):]}`"
+    elif not glued.fits:
+        hint = did_you_mean(word, keywords)
+    line, column = first.line or 1, first.column or 1
+    return RuleSyntaxError(f"unexpected `{word}`",
+                           span=Span.in_text(text, path, line, column, column + len(word)
+                                             if "\n" not in word else None),
+                           expected=(words or _expected)(expected), hint=hint)
+
+
+def keyword_glued(first: Token, second: Token, parser: Lark) -> bool:
+    """A keyword of ``parser`` cut out of one word with what touches it (``ifroad``,
+    ``with0.5``): names are ASCII, and a number glued to a name (``90x``) is said by
+    :func:`syntax_error`."""
+    return one_word(first, second) and str(first)[-1:].isascii() and \
+        str(second)[:1].isascii() and (_keyword(parser, first) or _keyword(parser, second))
+
+
+def _keyword(parser: Lark, token: Token) -> bool:
+    """Whether ``token`` is a keyword of ``parser``'s grammar (``if``, ``seed``), as opposed to
+    a name, a number or a file name."""
+    from lark.lexer import PatternStr
+
+    return any(t.name == token.type and isinstance(t.pattern, PatternStr)
+               and t.pattern.value.isalpha() for t in parser.terminals)
+
+
+#: `road iss WIDE`, read as `road is s` and then "unexpected `WIDE`"
 _GLUED_BEFORE = re.compile(r"(?<![\w-])([A-Za-z_][\w-]*)[ \t]+(is\w[\w-]*)\s*$")
 
 
@@ -689,31 +742,6 @@ def _glued_is_error(text: str, path: str | None, var: str, start: int, end: int,
     return RuleSyntaxError(f"unexpected `{word}`",
                            span=Span.in_text(text, path, line, column, column + len(word)),
                            expected="`is`", hint=hint)
-
-
-def check_glued_is(tree: Tree, text: str, path: str | None) -> None:
-    """Refuse ``road isWIDE`` (and ``speed is90``, ``road isnot WIDE``), which the lexer
-    read as ``road is WIDE``: `is` is a word of its own, as every keyword is elsewhere."""
-    if _GLUED_IS.search(text) is None:
-        return                            # the usual case: no walk
-    glued = []
-    for node in _subtrees(tree):
-        if node.data not in ("proposition", "term_consequent", "crisp_consequent"):
-            continue
-        var, after = node.children[0], node.children[1]
-        while isinstance(after, Tree):
-            after = after.children[0]
-        if not isinstance(var, Token) or not isinstance(after, Token) \
-                or var.end_pos is None or after.start_pos is None:
-            continue
-        start = after.start_pos - 2
-        if start >= var.end_pos and text[start:after.start_pos] == "is" \
-                and (str(after)[:1].isalnum() or str(after)[:1] == "_"):
-            glued.append((start, var, after))
-    if glued:
-        start, var, after = min(glued, key=lambda g: g[0])
-        raise _glued_is_error(text, path, str(var), start, after.end_pos or start + 2,
-                              str(after))
 
 
 #: what ``then y is not A`` is refused as: (the thing, the hint), or a hint made from its

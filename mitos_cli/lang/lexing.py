@@ -1,11 +1,12 @@
-"""Parsing a foreign text with its words kept whole (FCL files, FLL ``rule:`` lines).
+"""Parsing with words kept whole (rule files, lessons, FCL files, FLL ``rule:`` lines).
 
 Where a grammar allows only a keyword, Lark's contextual lexer looks for that keyword alone, so
 it takes a keyword off the front of a longer word and reads the rest as the next token:
 ``IF dist ISlo`` was read as ``IS lo``, ``WITH0.5`` as ``WITH 0.5``, ``END_FUZZIFYDEFUZZIFY``
 as two keywords. The engines that wrote these formats cut words apart only at blanks and
 punctuation (jFuzzyLogic's ANTLR lexer takes the longest match, fuzzylite splits a rule at its
-spaces), and refuse such a word where a keyword stands; :func:`parse_apart` does too.
+spaces), and refuse such a word where a keyword stands; :func:`parse_apart` does too, and so
+does the rule language, whose every keyword is a word of its own.
 """
 
 from __future__ import annotations
@@ -44,21 +45,24 @@ def one_word(first: Token, second: Token) -> bool:
         (_word_char(b[:1] or " ") or (b[:1] == "." and b[1:2].isdigit()))
 
 
-def parse_apart(parser: Lark, text: str) -> Tree:
-    """``parser.parse(text)``, raising :class:`Glued` at two tokens cut out of one word.
+def parse_apart(parser: Lark, text: str, start: str | None = None,
+                apart: Callable[[Token, Token], bool] = one_word) -> Tree:
+    """``parser.parse(text, start)``, raising :class:`Glued` at two tokens cut out of one word
+    (``apart`` says which: :func:`one_word`, or a language's own exceptions to it).
 
     Lark's errors are raised as they are, each :class:`UnexpectedToken` with its
     ``interactive_parser`` and, as ``token_history``, the token before it."""
-    interactive = parser.parse_interactive(text)
+    interactive = parser.parse_interactive(text, start=start)
     last: Token | None = None
     try:
         for token in interactive.iter_parse():
-            if last is not None and one_word(last, token):
+            # (the positions first: a blank or a comment between is the usual case)
+            if last is not None and last.end_pos == token.start_pos and apart(last, token):
                 raise Glued(last, token, token.type in interactive.accepts())
             last = token
         return interactive.feed_eof(last)
     except UnexpectedToken as exc:
-        if last is not None and exc.token.type != "$END" and one_word(last, exc.token):
+        if last is not None and exc.token.type != "$END" and apart(last, exc.token):
             # `END_RULEBLOCKx`: the rest of the word refused after the keyword
             raise Glued(last, exc.token, False) from None
         if exc.interactive_parser is None:      # set by Lark's parse(), not by feed_token()
@@ -68,10 +72,11 @@ def parse_apart(parser: Lark, text: str) -> Tree:
         raise
 
 
-def accepted_before(parser: Lark, text: str, token: Token) -> set[str]:
+def accepted_before(parser: Lark, text: str, token: Token, start: str | None = None
+                    ) -> set[str]:
     """The terminals ``parser`` accepts where ``token`` of ``text`` begins (``text`` parsed
     again up to it: only on an error, and linear)."""
-    interactive = parser.parse_interactive(text[:token.start_pos])
+    interactive = parser.parse_interactive(text[:token.start_pos], start=start)
     for _ in interactive.iter_parse():
         pass
     return set(interactive.accepts())
