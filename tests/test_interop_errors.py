@@ -494,6 +494,17 @@ def test_fcl_a_name_glued_to_a_keyword_is_named_in_the_hint(old: str, new: str, 
     assert (info.value.message, info.value.hint) == (f"unexpected `{at}`", hint)
 
 
+def test_an_unknown_method_lists_each_name_once() -> None:
+    """MATLAB's and jFuzzyLogic's bisectors are written as fuzzylite's: the list read
+    "COG, COA, MM, LM, RM, COA, LM, RM, COA, COGS, COGSS"."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("METHOD : COG;", "METHOD : COGx;", 1), "bad.fcl")
+    assert info.value.expected == "one of COG, COA, MM, LM, RM, COGS, COGSS"
+    with pytest.raises(FormatError) as info:
+        parse_fis(FIS.replace("DefuzzMethod='centroid'", "DefuzzMethod='centroidx'"), "b.fis")
+    assert info.value.expected == "one of centroid, bisector, mom, som, lom, wtaver, wtsum"
+
+
 def test_fcl_punctuation_is_quoted() -> None:
     with pytest.raises(FormatError) as info:
         parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")

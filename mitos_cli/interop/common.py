@@ -103,7 +103,8 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
         return FCL_ALIASES[name.upper()]
     if fmt == FIS and FIS_ALIASES.get(name) in table:
         return FIS_ALIASES[name]
-    pool = [n[fmt] for n in table.values() if n[fmt] is not None]
+    # (each once: MATLAB's and jFuzzyLogic's bisectors are FCL's `COA` as fuzzylite's is)
+    pool = list(dict.fromkeys(n[fmt] for n in table.values() if n[fmt] is not None))
     why = UNSUPPORTED_NORMS.get(name) or (UNSUPPORTED_NORMS.get(name.upper()) if fmt == FCL
                                           else None)
     if why:
