@@ -169,6 +169,21 @@ def caret_under(exc: MitosError) -> str:
      '`if` and `not` are two words: `if not`'),
     ('r1: ifff road is WIDE then speed is SLOW', 5, 'ifff', 'unexpected `ifff`', '`if`',
      'did you mean `if`?'),
+    # a term glued to a joining keyword, or the keyword to the next word, is one name: the
+    # error after it said "join conditions with `and` / `or`" (`andspeed is`: "actions are
+    # joined with `and`: `... and andspeed is ...`")
+    ('r1: if road is WIDEand size is SMALL_SZ then speed is SLOW', 24, 'size',
+     'unexpected `size`', '`then`', '`WIDEand` is read as one name: `WIDE` and `and` are '
+     'two words'),
+    ('r1: if road is WIDEthen speed is SLOW', 25, 'speed', 'unexpected `speed`', '`then`',
+     '`WIDEthen` is read as one name: `WIDE` and `then` are two words'),
+    ('r1: if road is WIDE andsize is SMALL_SZ then speed is SLOW', 21, 'andsize',
+     'unexpected `andsize`', '`then`', '`andsize` is read as one name: `and` and `size` are '
+     'two words'),
+    ('r1: if road is WIDE then steering is RS andspeed is SLOW', 50, 'is', 'unexpected `is`',
+     '`:`', '`andspeed` is read as one name: `and` and `speed` are two words'),
+    ('r1: if road is WIDE then speed is SLOWwith 0.5', 44, '0.5', 'unexpected `0.5`', None,
+     '`SLOWwith` is read as one name: `SLOW` and `with` are two words'),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)

@@ -29,7 +29,7 @@ from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
 from .cache import lark_parser
-from .lexing import Glued, accepted_before, one_word, parse_apart
+from .lexing import Glued, accepted_before, one_word, parse_apart, read_as_one_name
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, Setting, Use
 
 if TYPE_CHECKING:
@@ -163,6 +163,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     cut = _operators_cut_short(text, path, token.line)
     if cut is not None:
         return cut
+    glued_name = _glued_name(exc, text, path)
+    if glued_name is not None:
+        return glued_name
     stray = _stray_label(exc, text, path)
     if isinstance(stray, RuleSyntaxError):
         return stray
@@ -451,6 +454,47 @@ def _after_connective(text: str, token: Token) -> bool:
         return False
     return re.search(r"(?:\b(?:if|and|or|not|when)\b|\()\s*[A-Za-z_][\w\-]*\s*\Z",
                      text[:token.start_pos]) is not None
+
+
+#: the keywords that join (a word glued to one of them is read as one name: `WIDEand`)
+_JOINING = ("and", "or", "then", "with", "when")
+
+
+def _glued_name(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | None:
+    """The error at or after a name that is a term glued to a joining keyword (``road is
+    WIDEand size ...``, ``speed is SLOWwith 0.5``) or such a keyword glued to the word after
+    a term (``road is WIDE andsize is ...``, ``steering is RS andspeed is ...``): one name to
+    the lexer, and the error said only what was expected there (or, for ``andspeed is``, that
+    ``andspeed`` was a new rule's label without its ``:``)."""
+    token = exc.token
+    if token.type == "$END" or token.line is None or token.column is None:
+        return None
+    line = text.splitlines()[token.line - 1] if token.line <= len(text.splitlines()) else ""
+    words = line[:token.column - 1].split()
+    if token.type == "NAME":
+        words.append(str(token))
+    modifiers = {"is", "not", *HEDGE_NAMES}
+    hint = None
+    for i in range(len(words) - 1, max(len(words) - 3, 0), -1):
+        word = words[i]
+        if not re.fullmatch(r"[A-Za-z_][\w\-]*", word) or word in RESERVED:
+            continue
+        if words[i - 1] in modifiers:           # a term: `WIDEand`
+            hint = read_as_one_name(word, set(_JOINING), set(_JOINING))
+        elif i >= 2 and words[i - 2] in modifiers:      # after a term: `andsize`
+            said = next((k for k in _JOINING if word.startswith(k) and len(word) > len(k)
+                         and (word[len(k)].isalpha() or word[len(k)] == "_")), None)
+            if said is not None:
+                hint = (f"`{word}` is read as one name: `{said}` and `{word[len(said):]}` are "
+                        f"two words")
+        if hint is not None:
+            break
+    if hint is None:
+        return None
+    span = Span.in_text(text, path, token.line, token.column,
+                        token.column + max(1, len(str(token.value))))
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(exc.expected), hint=hint)
 
 
 def _word_before(text: str, token: Token) -> str:
