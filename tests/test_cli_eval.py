@@ -854,16 +854,20 @@ def test_an_input_without_a_value_is_said_to_be_empty(capsys):
                                 "hint: give it after the `=`, in the same word: `road=78`"]
 
 
-@pytest.mark.parametrize("args", [["road=78,size=45,position=4"],
-                                  ["road=78;size=45;position=4"],
-                                  ["road=78, size=45, position=4"]])
-def test_inputs_run_together_are_shown_apart(args, capsys):
+@pytest.mark.parametrize("args, apart", [
+    (["road=78,size=45,position=4"], "road=78 size=45 position=4"),
+    (["road=78;size=45;position=4"], "road=78 size=45 position=4"),
+    (["road=78, size=45, position=4"], "road=78 size=45 position=4"),
+    # glued without a separator, the hint wrote the word back as it was (`road=78size=45`)
+    (["road=78size=45position=4"], "road=78 size=45 position=4"),
+    (["road=78size=45", "position=4"], "road=78 size=45"),
+])
+def test_inputs_run_together_are_shown_apart(args, apart, capsys):
     """`mitos eval road=78,size=45,position=4` said only that `road` must be a number, not
     `78,size=45,position=4`: the hint now writes the inputs as the command takes them."""
     code, out, err = run_main(["eval", *args], capsys)
     assert code == 1 and out == ""
-    assert "hint: give each input as a word of its own, apart with spaces: " \
-           "`road=78 size=45 position=4`" in err
+    assert f"hint: give each input as a word of its own, apart with spaces: `{apart}`" in err
     code, _, err = run_main(["eval", "road=78,", "size=45,", "position=4"], capsys)
     assert code == 1
     assert "hint: inputs are apart with spaces only: write `road=78`, without `,`" in err
