@@ -118,6 +118,12 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`to` and `14s` are two words: `to 14s`"),
     ("at 12.5s to14s steering=55", "unexpected `to14s`", "`to` and the time",
      "`to` and `14s` are two words: `to 14s`"),
+    # a term glued to `and` is one name (the error at the next word said only what was
+    # expected there)
+    ("correct road=78 -> steering is LMand speed is SLOW", "unexpected `speed`", "`and`",
+     "`LMand` is read as one name: `LM` and `and` are two words"),
+    ("r1: if road is WIDEand size is SMALL_SZ then speed is SLOW", "unexpected `size`",
+     "`then`", "`WIDEand` is read as one name: `WIDE` and `and` are two words"),
     ("simulate figure4 seed x", "unexpected `x`", "a seed", "a seed is a whole number"),
     ("simulate my world.yaml", "unexpected `world`", "`robot` or `seed`", "is quoted"),
     # a mistyped option after the world's name was taken for a name with a space in it

@@ -461,40 +461,47 @@ _JOINING = ("and", "or", "then", "with", "when")
 
 
 def _glued_name(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | None:
-    """The error at or after a name that is a term glued to a joining keyword (``road is
-    WIDEand size ...``, ``speed is SLOWwith 0.5``) or such a keyword glued to the word after
-    a term (``road is WIDE andsize is ...``, ``steering is RS andspeed is ...``): one name to
-    the lexer, and the error said only what was expected there (or, for ``andspeed is``, that
-    ``andspeed`` was a new rule's label without its ``:``)."""
+    """The error at or after a name that is a term glued to a joining keyword, said with
+    :func:`glued_name_hint`."""
     token = exc.token
-    if token.type == "$END" or token.line is None or token.column is None:
+    hint = glued_name_hint(text, token)
+    if hint is None or token.line is None or token.column is None:
         return None
-    line = text.splitlines()[token.line - 1] if token.line <= len(text.splitlines()) else ""
-    words = line[:token.column - 1].split()
+    span = Span.in_text(text, path, token.line, token.column,
+                        token.column + max(1, len(str(token.value))))
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(exc.expected), hint=hint)
+
+
+def glued_name_hint(text: str, token: Token) -> str | None:
+    """A hint for the error at ``token`` when it or a word just before it is a term glued to a
+    joining keyword (``road is WIDEand size ...``, ``speed is SLOWwith 0.5``) or such a keyword
+    glued to the word after a term (``road is WIDE andsize is ...``, ``steering is RS andspeed
+    is ...``): one name to the lexer, and the error said only what was expected there (or,
+    for ``andspeed is``, that ``andspeed`` was a new rule's label without its ``:``)."""
+    lines = text.splitlines()
+    if token.type == "$END" or token.line is None or token.column is None \
+            or token.line > len(lines):
+        return None
+    words = lines[token.line - 1][:token.column - 1].split()
     if token.type == "NAME":
         words.append(str(token))
     modifiers = {"is", "not", *HEDGE_NAMES}
-    hint = None
     for i in range(len(words) - 1, max(len(words) - 3, 0), -1):
         word = words[i]
         if not re.fullmatch(r"[A-Za-z_][\w\-]*", word) or word in RESERVED:
             continue
         if words[i - 1] in modifiers:           # a term: `WIDEand`
             hint = read_as_one_name(word, set(_JOINING), set(_JOINING))
+            if hint is not None:
+                return hint
         elif i >= 2 and words[i - 2] in modifiers:      # after a term: `andsize`
             said = next((k for k in _JOINING if word.startswith(k) and len(word) > len(k)
                          and (word[len(k)].isalpha() or word[len(k)] == "_")), None)
             if said is not None:
-                hint = (f"`{word}` is read as one name: `{said}` and `{word[len(said):]}` are "
+                return (f"`{word}` is read as one name: `{said}` and `{word[len(said):]}` are "
                         f"two words")
-        if hint is not None:
-            break
-    if hint is None:
-        return None
-    span = Span.in_text(text, path, token.line, token.column,
-                        token.column + max(1, len(str(token.value))))
-    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
-                           expected=_expected(exc.expected), hint=hint)
+    return None
 
 
 def _word_before(text: str, token: Token) -> str:

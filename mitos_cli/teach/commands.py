@@ -34,6 +34,7 @@ from ..lang.parse import (
     check_nesting,
     check_settings,
     glued_error,
+    glued_name_hint,
     joined_hint,
     keyword_glued,
     keyword_hint,
@@ -694,7 +695,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         # a target reuses the rule language's consequent, which a rule's `with` may follow;
         # a target takes no weight, and the line may end after it
         expected = expected - {"WITH"} | {"$END"}
-    hint = _teach_hint(text, token, before) if str(token.value) != ";" else None
+    hint = _teach_hint(text, token, before) or glued_name_hint(text, token) \
+        if str(token.value) != ";" else None
     if hint is not None:
         pass
     elif str(token.value) == ";":          # FCL's `... then speed is SLOW;` (not a hedge)
