@@ -330,6 +330,16 @@ def test_missing_rule_file():
      "did you mean `SLOW`?", "SLWO"),
     ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
      "did you mean `WIDE`?", "wide"),
+    # `not` or a hedge glued to the term: "did you mean `WIDE`?" dropped the `not`, and
+    # following it turned the condition over
+    ("r1: if road is notWIDE then speed is SLOW", "unknown term `notWIDE` of `road`",
+     "`not` and `WIDE` are two words: `road is not WIDE`", "notWIDE"),
+    ("r1: if road is veryWIDE then speed is SLOW", "unknown term `veryWIDE` of `road`",
+     "`very` and `WIDE` are two words: `road is very WIDE`", "veryWIDE"),
+    ("r1: if road is more_or_lessWIDE then speed is SLOW",
+     "unknown term `more_or_lessWIDE` of `road`",
+     "`more_or_less` and `WIDE` are two words: `road is more_or_less WIDE`",
+     "more_or_lessWIDE"),
 ])
 def test_unknown_names(tmp_path, rule, message, hint, at):
     path = write(tmp_path, rule)

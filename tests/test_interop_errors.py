@@ -505,6 +505,16 @@ def test_an_unknown_method_lists_each_name_once() -> None:
     assert info.value.expected == "one of centroid, bisector, mom, som, lom, wtaver, wtsum"
 
 
+def test_a_hedge_or_not_glued_to_a_term_is_two_words_not_the_term() -> None:
+    """`IS NOTexcellent` said "did you mean `excellent`?", which drops the NOT."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("IS NOT excellent", "IS NOTexcellent", 1), "bad.fcl")
+    assert info.value.hint == "`NOT` and `excellent` are two words: `service is NOT excellent`"
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("if a is low and", "if a is verylow and"), "bad.fll")
+    assert info.value.hint == "`very` and `low` are two words: `a is very low`"
+
+
 def test_fcl_punctuation_is_quoted() -> None:
     with pytest.raises(FormatError) as info:
         parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")
