@@ -336,6 +336,8 @@ def test_missing_rule_file():
      "`not` and `WIDE` are two words: `road is not WIDE`", "notWIDE"),
     ("r1: if road is veryWIDE then speed is SLOW", "unknown term `veryWIDE` of `road`",
      "`very` and `WIDE` are two words: `road is very WIDE`", "veryWIDE"),
+    ("r1: if notroad is WIDE then speed is SLOW", "unknown input variable `notroad`",
+     "`not` and `road` are two words", "notroad"),
     ("r1: if road is more_or_lessWIDE then speed is SLOW",
      "unknown term `more_or_lessWIDE` of `road`",
      "`more_or_less` and `WIDE` are two words: `road is more_or_less WIDE`",
