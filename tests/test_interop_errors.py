@@ -515,6 +515,30 @@ def test_a_hedge_or_not_glued_to_a_term_is_two_words_not_the_term() -> None:
     assert info.value.hint == "`very` and `low` are two words: `a is very low`"
 
 
+@pytest.mark.parametrize("old, new, at, hint", [
+    # a keyword split in two: "unexpected `END`" with "did you mean `AND`?"
+    ("END_RULEBLOCK", "END RULEBLOCK", "END", "`END RULEBLOCK` is one word: `END_RULEBLOCK`"),
+    ("VAR_INPUT", "VAR INPUT", "VAR", "`VAR INPUT` is one word: `VAR_INPUT`"),
+    ("END_FUZZIFY", "END FUZZIFY", "END", "`END FUZZIFY` is one word: `END_FUZZIFY`"),
+    # `END` read as a variable's name, the error at `VAR`
+    ("\tfood : REAL;\nEND_VAR", "\tfood : REAL;\nEND VAR", "VAR",
+     "`END VAR` is one word: `END_VAR`"),
+    # `FUNCTION` began a formula that ran to the next `;`, lines on, all of it "unexpected"
+    ("FUNCTION_BLOCK tipper", "FUNCTION BLOCK tipper", "FUNCTION",
+     "`FUNCTION BLOCK` is one word: `FUNCTION_BLOCK`"),
+    # the `_` left out: `ENDVAR` was a variable's name, the error at the next line
+    ("\tfood : REAL;\nEND_VAR", "\tfood : REAL;\nENDVAR", "VAR_OUTPUT",
+     "`ENDVAR` is read as a name: did you mean `END_VAR`?"),
+])
+def test_fcl_a_keyword_split_in_two_is_said_as_one_word(old: str, new: str, at: str,
+                                                       hint: str) -> None:
+    assert old in FCL, old
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace(old, new, 1), "bad.fcl")
+    assert (info.value.message, info.value.hint) == (f"unexpected `{at}`", hint)
+    assert info.value.render().splitlines()[2].strip() == "^" * len(at)
+
+
 def test_fcl_punctuation_is_quoted() -> None:
     with pytest.raises(FormatError) as info:
         parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")

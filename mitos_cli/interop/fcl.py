@@ -109,17 +109,29 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
         line, column = len(lines), len(lines[-1]) + 1
         what = "unexpected end of file"
     elif isinstance(exc, UnexpectedToken):
-        what = f"unexpected `{exc.token}`"
-        end_column = column + len(str(exc.token))
+        # (a FUNCTION term's formula runs to the next `;`: `FUNCTION BLOCK` took lines)
+        shown = str(exc.token).split()[0] if exc.token.type == "FORMULA" else str(exc.token)
+        what = f"unexpected `{shown}`"
+        end_column = column + len(shown)
         if exc.interactive_parser is not None:      # `expected` may hold LALR's merged states
             expected = set(exc.interactive_parser.accepts()) or expected
-        if exc.token.type == "NAME":                # a word where a keyword stands
+        keywords = set(_keywords(t.name for t in parser().terminals))
+        if exc.token.type in ("NAME", "FORMULA"):   # `END RULEBLOCK`: one word, split
+            after = re.match(r"[ \t]+([A-Za-z_]\w*)", text[exc.token.start_pos + len(shown):]
+                             if exc.token.start_pos is not None else "")
+            joined = f"{shown}_{after.group(1)}".upper() if after else ""
+            if joined in keywords:
+                hint = f"`{shown} {after.group(1)}` is one word: `{joined}`" if after else None
+        if hint is None and exc.token.type == "NAME":   # a word where a keyword stands
             hint = did_you_mean(str(exc.token), _keywords(expected))
         before = (exc.token_history or [None])[-1]
+        if hint is None and before is not None and before.type == "NAME" \
+                and f"{before}_{shown}".upper() in keywords:      # `END VAR`, `END` a name
+            hint = f"`{before} {shown}` is one word: `{f'{before}_{shown}'.upper()}`"
         if hint is None and before is not None and before.type == "NAME":
-            hint = read_as_one_name(str(before), set(_keywords(expected)),
-                                    set(_keywords(t.name for t in parser().terminals)),
-                                    fold=str.upper)
+            hint = read_as_one_name(str(before), set(_keywords(expected)), keywords,
+                                    fold=str.upper) or _underscore_dropped(str(before),
+                                                                           keywords)
     elif isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
@@ -128,6 +140,13 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
         what = "cannot read this"
     return FormatError(what, span=Span.in_text(text, path, line, column, end_column),
                        expected=_expected(expected), hint=hint)
+
+
+def _underscore_dropped(name: str, keywords: set[str]) -> str | None:
+    """``ENDVAR`` read as a variable's name before the error: a keyword without its `_`."""
+    written = next((k for k in keywords if "_" in k and k.replace("_", "") == name.upper()),
+                   None)
+    return f"`{name}` is read as a name: did you mean `{written}`?" if written else None
 
 
 #: option keys (one terminal, OPTION_KEY) as FCL writes them
