@@ -186,6 +186,18 @@ def test_fll_a_term_name_glued_to_its_type_is_named_in_the_hint() -> None:
         "`lowTriangle` is read as the term's name: `low` and `Triangle` are two words")
 
 
+@pytest.mark.parametrize("old, new, hint", [
+    # a section's name split in two was an unknown key of the section above, with no hint
+    ("InputVariable: b", "Input Variable: b", "`Input Variable` is one word: `InputVariable`"),
+    ("RuleBlock: main", "Rule Block: main", "`Rule Block` is one word: `RuleBlock`"),
+    ("  lock-range: false", "  lock range: false", "`lock range` is one word: `lock-range`"),
+])
+def test_fll_a_key_split_in_two_is_said_as_one_word(old: str, new: str, hint: str) -> None:
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll(old, new), "bad.fll")
+    assert info.value.message.startswith("unknown ") and info.value.hint == hint
+
+
 def test_fll_error_points_at_the_line() -> None:
     text = fll("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5")
     with pytest.raises(FormatError) as info:

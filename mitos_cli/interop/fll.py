@@ -229,9 +229,13 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
             raise FormatError(f"`{key}` before any section", span=span,
                               expected="Engine:, InputVariable:, OutputVariable: or RuleBlock:")
         if key not in KEYS[section]:
+            joined = "".join(key.split())
+            split = next((k for k in (*SECTIONS, *KEYS[section]) if k in (joined, "-".join(
+                key.split()))), None) if joined != key else None      # `Input Variable`
             raise FormatError(f"unknown {section} key `{key}`", span=span,
                               expected="one of " + ", ".join(KEYS[section]),
-                              hint=did_you_mean(key, KEYS[section]))
+                              hint=f"`{key}` is one word: `{split}`" if split else
+                              did_you_mean(key, KEYS[section]))
         if key == "description":
             if current is not None:
                 current.description = value
