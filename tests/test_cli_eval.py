@@ -778,6 +778,34 @@ def test_every_misspelt_column_is_named():
                                "you mean `size`, `position`?")
 
 
+@pytest.mark.parametrize("header, at, hint", [
+    # two names in one column: "columns `road size`, `road size` are passed through as they
+    # are: did you mean `road`, `size`?", the column named twice and no word of the comma
+    ("road size,position", "1:1", "column `road size` names `road` and `size`: columns are "
+     "separated by commas, `road,size`"),
+    ("roadsize,position", "1:1", "column `roadsize` names `road` and `size`: columns are "
+     "separated by commas, `road,size`"),
+    ("road,sizeposition", "1:6", "column `sizeposition` names `size` and `position`: columns "
+     "are separated by commas, `size,position`"),
+    ("roadsizeposition", "1:1", "column `roadsizeposition` names `road`, `size` and "
+     "`position`: columns are separated by commas, `road,size,position`"),
+])
+def test_names_glued_in_one_column_are_said_apart(header, at, hint):
+    with pytest.raises(InputError) as info:
+        read_batch(header + "\n78,45,4\n", "g.csv", ("road", "size", "position"))
+    assert str(info.value.span) == f"g.csv:{at}" and info.value.hint == hint
+
+
+def test_a_header_ending_in_a_comma_is_named():
+    """`road,size,position,` has a fourth column without a name: "row has 3 values, the
+    header 4" did not say where the fourth is."""
+    with pytest.raises(InputError) as info:
+        read_batch("road,size,position,\n78,45,4\n", "t.csv", ("road", "size", "position"))
+    assert info.value.message == "row has 3 values, the header 4"
+    assert info.value.hint == "the header ends in `,`: its last column has no name; delete " \
+                              "that comma"
+
+
 def test_a_bad_cell_early_in_a_large_batch_stops_the_reading(monkeypatch):
     """The reading goes chunk by chunk and stops at the first bad one: the rows after it are
     never converted."""
@@ -826,16 +854,20 @@ def test_an_input_without_a_value_is_said_to_be_empty(capsys):
                                 "hint: give it after the `=`, in the same word: `road=78`"]
 
 
-@pytest.mark.parametrize("args", [["road=78,size=45,position=4"],
-                                  ["road=78;size=45;position=4"],
-                                  ["road=78, size=45, position=4"]])
-def test_inputs_run_together_are_shown_apart(args, capsys):
+@pytest.mark.parametrize("args, apart", [
+    (["road=78,size=45,position=4"], "road=78 size=45 position=4"),
+    (["road=78;size=45;position=4"], "road=78 size=45 position=4"),
+    (["road=78, size=45, position=4"], "road=78 size=45 position=4"),
+    # glued without a separator, the hint wrote the word back as it was (`road=78size=45`)
+    (["road=78size=45position=4"], "road=78 size=45 position=4"),
+    (["road=78size=45", "position=4"], "road=78 size=45"),
+])
+def test_inputs_run_together_are_shown_apart(args, apart, capsys):
     """`mitos eval road=78,size=45,position=4` said only that `road` must be a number, not
     `78,size=45,position=4`: the hint now writes the inputs as the command takes them."""
     code, out, err = run_main(["eval", *args], capsys)
     assert code == 1 and out == ""
-    assert "hint: give each input as a word of its own, apart with spaces: " \
-           "`road=78 size=45 position=4`" in err
+    assert f"hint: give each input as a word of its own, apart with spaces: `{apart}`" in err
     code, _, err = run_main(["eval", "road=78,", "size=45,", "position=4"], capsys)
     assert code == 1
     assert "hint: inputs are apart with spaces only: write `road=78`, without `,`" in err

@@ -80,8 +80,10 @@ def caret_under(exc: MitosError) -> str:
     ("r1: if road is WIDE then speed is", 34, None, "unexpected end of the input", "a name",
      None),
     ("r1: if (road is WIDE then speed is SLOW", 22, "then", "unexpected `then`", "`)`", None),
-    ("r1: iff road is WIDE then speed is SLOW", 9, "road", "unexpected `road`", "`is`",
-     "`iff` is read as a variable's name: did you mean `if`?"),
+    # (until 2026-12-07 read as `if f`, then "unexpected `road`": the lexer took `if` off
+    # the front of `iff` where only `if` may stand)
+    ("r1: iff road is WIDE then speed is SLOW", 5, "iff", "unexpected `iff`", "`if`",
+     "did you mean `if`?"),
     ("r1: if road is WIDE thn speed is SLOW", 21, "thn", "unexpected `thn`", "`then`",
      "did you mean `then`?"),
     # `=` for `is`, and FCL's `;` at a rule's end: said how a rule file writes them
@@ -159,6 +161,29 @@ def caret_under(exc: MitosError) -> str:
      'did you mean `is`?'),
     ('r1: if (road is WIDE) and size isvery SMALL_SZ then speed is SLOW', 32, 'isvery',
      'unexpected `isvery`', '`is`', '`is` and `very` are two words: `size is very`'),
+    # every keyword is a word of its own: where only `if` may stand (after a label), `ifroad`
+    # was read as `if road` without a word
+    ('r1: ifroad is WIDE then speed is SLOW', 5, 'ifroad', 'unexpected `ifroad`', '`if`',
+     '`if` and `road` are two words: `if road`'),
+    ('r1: ifnot road is WIDE then speed is SLOW', 5, 'ifnot', 'unexpected `ifnot`', '`if`',
+     '`if` and `not` are two words: `if not`'),
+    ('r1: ifff road is WIDE then speed is SLOW', 5, 'ifff', 'unexpected `ifff`', '`if`',
+     'did you mean `if`?'),
+    # a term glued to a joining keyword, or the keyword to the next word, is one name: the
+    # error after it said "join conditions with `and` / `or`" (`andspeed is`: "actions are
+    # joined with `and`: `... and andspeed is ...`")
+    ('r1: if road is WIDEand size is SMALL_SZ then speed is SLOW', 24, 'size',
+     'unexpected `size`', '`then`', '`WIDEand` is read as one name: `WIDE` and `and` are '
+     'two words'),
+    ('r1: if road is WIDEthen speed is SLOW', 25, 'speed', 'unexpected `speed`', '`then`',
+     '`WIDEthen` is read as one name: `WIDE` and `then` are two words'),
+    ('r1: if road is WIDE andsize is SMALL_SZ then speed is SLOW', 21, 'andsize',
+     'unexpected `andsize`', '`then`', '`andsize` is read as one name: `and` and `size` are '
+     'two words'),
+    ('r1: if road is WIDE then steering is RS andspeed is SLOW', 50, 'is', 'unexpected `is`',
+     '`:`', '`andspeed` is read as one name: `and` and `speed` are two words'),
+    ('r1: if road is WIDE then speed is SLOWwith 0.5', 44, '0.5', 'unexpected `0.5`', None,
+     '`SLOWwith` is read as one name: `SLOW` and `with` are two words'),
 ])
 def test_syntax_errors(tmp_path, line, col, at, message, expected, hint):
     path = write(tmp_path, line)
@@ -305,6 +330,18 @@ def test_missing_rule_file():
      "did you mean `SLOW`?", "SLWO"),
     ("r1: if road is wide then speed is SLOW", "unknown term `wide` of `road`",
      "did you mean `WIDE`?", "wide"),
+    # `not` or a hedge glued to the term: "did you mean `WIDE`?" dropped the `not`, and
+    # following it turned the condition over
+    ("r1: if road is notWIDE then speed is SLOW", "unknown term `notWIDE` of `road`",
+     "`not` and `WIDE` are two words: `road is not WIDE`", "notWIDE"),
+    ("r1: if road is veryWIDE then speed is SLOW", "unknown term `veryWIDE` of `road`",
+     "`very` and `WIDE` are two words: `road is very WIDE`", "veryWIDE"),
+    ("r1: if notroad is WIDE then speed is SLOW", "unknown input variable `notroad`",
+     "`not` and `road` are two words", "notroad"),
+    ("r1: if road is more_or_lessWIDE then speed is SLOW",
+     "unknown term `more_or_lessWIDE` of `road`",
+     "`more_or_less` and `WIDE` are two words: `road is more_or_less WIDE`",
+     "more_or_lessWIDE"),
 ])
 def test_unknown_names(tmp_path, rule, message, hint, at):
     path = write(tmp_path, rule)

@@ -131,6 +131,73 @@ def test_fll_errors(old: str, new: str, words: str) -> None:
     assert span is not None and span.path == "bad.fll" and span.line >= 1
 
 
+# A rule's keyword glued to the next word: the contextual lexer took it off the word's front
+# (`a islow` was `a is low`); fuzzylite splits a rule at its blanks and refuses the word.
+@pytest.mark.parametrize("old, new, word, expected, hint", [
+    ("if a is low and", "if a islow and", "islow", "one of is",
+     "`is` and `low` are two words: `is low`"),
+    ("is small then y", "is small theny", "theny", "one of and, or, then",
+     "`then` and `y` are two words: `then y`"),
+    ("is on with 0.5", "is on with0.5", "with0.5", "one of and, the end of the rule, with",
+     "`with` and `0.5` are two words: `with 0.5`"),
+    ("rule: if a is low", "rule: ifa is low", "ifa", "one of if",
+     "`if` and `a` are two words: `if a`"),
+    ("is low and b", "is low andb", "andb", "one of and, or, then",
+     "`and` and `b` are two words: `and b`"),
+    ("is high or b", "is high orb", "orb", "one of and, or, then",
+     "`or` and `b` are two words: `or b`"),
+    ("if a is low and", "if a isvery low and", "isvery", "one of is",
+     "`is` and `very` are two words: `is very`"),
+    ("with 0.5", "with 0.5x", "0.5x", "one of a number", None),
+])
+def test_fll_a_keyword_glued_to_the_next_word_is_refused_at_the_word(
+        old: str, new: str, word: str, expected: str, hint: str | None) -> None:
+    text = fll(old, new)
+    with pytest.raises(FormatError) as info:
+        parse_fll(text, "bad.fll")
+    exc = info.value
+    assert (exc.message, exc.expected, exc.hint) == (f"unexpected `{word}`", expected, hint)
+    line = text.splitlines()[exc.span.line - 1]
+    assert line[exc.span.column - 1:].startswith(word)
+    assert exc.render().splitlines()[2].strip() == "^" * len(word)
+
+
+def test_fll_a_term_glued_to_a_keyword_is_named_in_the_hint() -> None:
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("then y is on with 0.5", "then y is onwith 0.5"), "bad.fll")
+    assert info.value.render() == (
+        "bad.fll:26:51: format error: cannot read this rule\n"
+        "      rule: if a is high or b is big then y is onwith 0.5\n"
+        "                                                      ^\n"
+        "expected one of and, the end of the rule, with\n"
+        "hint: `onwith` is read as one name: `on` and `with` are two words")
+    with pytest.raises(FormatError) as info:       # the end of the rule said after it
+        parse_fll(fll("then y is on with 0.5", "then y is on with"), "bad.fll")
+    assert (info.value.span.column, info.value.expected) == (51, "one of a number")
+
+
+def test_fll_a_term_name_glued_to_its_type_is_named_in_the_hint() -> None:
+    """`term: lowTriangle 0 2 5` took `lowTriangle` for the name and `0` for the type, with no
+    word on why."""
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("term: low Triangle 0 2 5", "term: lowTriangle 0 2 5"), "bad.fll")
+    assert (info.value.message, info.value.hint) == (
+        "term `lowTriangle`: unknown term type `0`",
+        "`lowTriangle` is read as the term's name: `low` and `Triangle` are two words")
+
+
+@pytest.mark.parametrize("old, new, hint", [
+    # a section's name split in two was an unknown key of the section above, with no hint
+    ("InputVariable: b", "Input Variable: b", "`Input Variable` is one word: `InputVariable`"),
+    ("RuleBlock: main", "Rule Block: main", "`Rule Block` is one word: `RuleBlock`"),
+    ("  lock-range: false", "  lock range: false", "`lock range` is one word: `lock-range`"),
+])
+def test_fll_a_key_split_in_two_is_said_as_one_word(old: str, new: str, hint: str) -> None:
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll(old, new), "bad.fll")
+    assert info.value.message.startswith("unknown ") and info.value.hint == hint
+
+
 def test_fll_error_points_at_the_line() -> None:
     text = fll("term: low Triangle 0 2 5", "term: low Triangle 0 2 5 0.5")
     with pytest.raises(FormatError) as info:
@@ -341,6 +408,147 @@ def test_fcl_keywords_as_fcl_writes_them(old: str, new: str, at: str, hint: str 
     assert exc.expected == "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, TERM"
     caret = exc.render().splitlines()[2]
     assert caret.strip() == "^" * len(at)
+
+
+# A keyword glued to the next word: Lark's contextual lexer took the keyword off the front of
+# the word where only a keyword could stand, and read `ISgood` as `IS good`, `WITH0.8` as `WITH
+# 0.8`; jFuzzyLogic's lexer reads the word as one identifier and refuses it. It is said at the
+# word, with what could stand there.
+@pytest.mark.parametrize("old, new, word, expected, hint", [
+    ("IF service IS good", "IF service ISgood", "ISgood", "one of AND, IS, OR, THEN",
+     "`IS` and `good` are two words: `IS good`"),
+    ("IS good THEN tip", "IS good THENtip", "THENtip", "one of AND, OR, THEN",
+     "`THEN` and `tip` are two words: `THEN tip`"),
+    ("RULE 2 : IF service", "RULE 2 : IFservice", "IFservice", "one of IF",
+     "`IF` and `service` are two words: `IF service`"),
+    ("IS poor OR food", "IS poor ORfood", "ORfood", "one of AND, OR, THEN",
+     "`OR` and `food` are two words: `OR food`"),
+    ("IS excellent AND food", "IS excellent ANDfood", "ANDfood", "one of AND, OR, THEN",
+     "`AND` and `food` are two words: `AND food`"),
+    ("IF NOT (", "IFNOT (", "IFNOT", "one of IF", "`IF` and `NOT` are two words: `IF NOT`"),
+    ("service IS NOT excellent", "service ISNOT excellent", "ISNOT", "one of AND, IS, OR, THEN",
+     "`IS` and `NOT` are two words: `IS NOT`"),
+    ("WITH 0.8", "WITH0.8", "WITH0.8",
+     "one of AND, END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE, WITH, `,`, `;`",
+     "`WITH` and `0.8` are two words: `WITH 0.8`"),
+    ("RULE 2 :", "RULE2 :", "RULE2", "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE",
+     "`RULE` and `2` are two words: `RULE 2`"),
+    ("TERM poor", "TERMpoor", "TERMpoor", "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, "
+     "TERM", "`TERM` and `poor` are two words: `TERM poor`"),
+    ("FUZZIFY food", "FUZZIFYfood", "FUZZIFYfood", "one of DEFUZZIFY, END_FUNCTION_BLOCK, "
+     "FUZZIFY, RULEBLOCK, VAR_INPUT, VAR_OUTPUT", "`FUZZIFY` and `food` are two words: "
+     "`FUZZIFY food`"),
+    ("RULEBLOCK No1", "RULEBLOCKNo1", "RULEBLOCKNo1", "one of DEFUZZIFY, END_FUNCTION_BLOCK, "
+     "FUZZIFY, RULEBLOCK, VAR_INPUT, VAR_OUTPUT", "`RULEBLOCK` and `No1` are two words: "
+     "`RULEBLOCK No1`"),
+    ("FUNCTION_BLOCK tipper", "FUNCTION_BLOCKtipper", "FUNCTION_BLOCKtipper",
+     "one of FUNCTION_BLOCK", "`FUNCTION_BLOCK` and `tipper` are two words: "
+     "`FUNCTION_BLOCK tipper`"),
+    ("END_FUZZIFY\n\nDEFUZZIFY", "END_FUZZIFYDEFUZZIFY", "END_FUZZIFYDEFUZZIFY",
+     "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, TERM",
+     "`END_FUZZIFY` and `DEFUZZIFY` are two words: `END_FUZZIFY DEFUZZIFY`"),
+    ("END_RULEBLOCK\n\nEND_FUNCTION_BLOCK", "END_RULEBLOCKEND_FUNCTION_BLOCK",
+     "END_RULEBLOCKEND_FUNCTION_BLOCK", "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE",
+     "`END_RULEBLOCK` and `END_FUNCTION_BLOCK` are two words: "
+     "`END_RULEBLOCK END_FUNCTION_BLOCK`"),
+    # what follows is no word that may follow the keyword: the keyword misspelt
+    ("END_RULEBLOCK", "END_RULEBLOCKx", "END_RULEBLOCKx",
+     "one of END_RULEBLOCK, METHOD/ACCU/AND/OR/ACT, RULE", "did you mean `END_RULEBLOCK`?"),
+    # numbers glued: `10x` was `10` and a parameter named `x`, `5.5.5` was 5.5 and 0.5
+    ("trian 0 5 10", "trian 0 5 10x", "10x", "one of `;`, a name, a number, inf, nan", None),
+    ("trian 0 5 10", "trian 0 5.5.5", "5.5.5", "one of `;`, a name, a number, inf, nan", None),
+])
+def test_fcl_a_keyword_glued_to_the_next_word_is_refused_at_the_word(
+        old: str, new: str, word: str, expected: str, hint: str | None) -> None:
+    assert old in FCL, old
+    text = FCL.replace(old, new, 1)
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text, "bad.fcl")
+    exc = info.value
+    assert (exc.message, exc.expected, exc.hint) == (f"unexpected `{word}`", expected, hint)
+    line = text.splitlines()[exc.span.line - 1]
+    assert line[exc.span.column - 1:].startswith(word)
+    assert exc.render().splitlines()[2].strip() == "^" * len(word)
+
+
+def test_fcl_a_glued_keyword_in_fuzzylites_dialect_is_said_in_full() -> None:
+    text = (Path(__file__).parent / "data" / "interop" / "dimmer_fuzzylite.fcl").read_text()
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text.replace("if Ambient is DARK", "if Ambient isDARK"), "dimmer.fcl")
+    assert info.value.render() == (
+        "dimmer.fcl:32:21: format error: unexpected `isDARK`\n"
+        "    RULE 1 : if Ambient isDARK then Power is HIGH\n"
+        "                        ^^^^^^\n"
+        "expected one of AND, IS, OR, THEN\n"
+        "hint: `is` and `DARK` are two words: `is DARK`")
+    with pytest.raises(FormatError) as info:
+        parse_fcl(text.replace("with 0.5", "with0.5"), "dimmer.fcl")
+    assert info.value.message == "unexpected `with0.5`"
+
+
+@pytest.mark.parametrize("old, new, at, hint", [
+    # a word that ends in a keyword the parser expects next is one name (as jFuzzyLogic reads
+    # it): the error comes at the word after it, and says why
+    ("IS poor OR food", "IS poorOR food", "food", "`poorOR` is read as one name: `poor` and "
+     "`OR` are two words"),
+    ("IS rancid THEN tip IS cheap", "IS rancidTHEN tip IS cheap", "tip", "`rancidTHEN` is "
+     "read as one name: `rancid` and `THEN` are two words"),
+    ("\tservice : REAL;", "\tservice : REALRANGE := (0 .. 10);", ":=", "`REALRANGE` is read "
+     "as one name: `REAL` and `RANGE` are two words"),
+    ("END_VAR\n\nVAR_OUTPUT", "END_VARVAR_OUTPUT", "tip", "`END_VARVAR_OUTPUT` is read as "
+     "one name: `END_VAR` and `VAR_OUTPUT` are two words"),
+])
+def test_fcl_a_name_glued_to_a_keyword_is_named_in_the_hint(old: str, new: str, at: str,
+                                                            hint: str) -> None:
+    assert old in FCL, old
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace(old, new, 1), "bad.fcl")
+    assert (info.value.message, info.value.hint) == (f"unexpected `{at}`", hint)
+
+
+def test_an_unknown_method_lists_each_name_once() -> None:
+    """MATLAB's and jFuzzyLogic's bisectors are written as fuzzylite's: the list read
+    "COG, COA, MM, LM, RM, COA, LM, RM, COA, COGS, COGSS"."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("METHOD : COG;", "METHOD : COGx;", 1), "bad.fcl")
+    assert info.value.expected == "one of COG, COA, MM, LM, RM, COGS, COGSS"
+    with pytest.raises(FormatError) as info:
+        parse_fis(FIS.replace("DefuzzMethod='centroid'", "DefuzzMethod='centroidx'"), "b.fis")
+    assert info.value.expected == "one of centroid, bisector, mom, som, lom, wtaver, wtsum"
+
+
+def test_a_hedge_or_not_glued_to_a_term_is_two_words_not_the_term() -> None:
+    """`IS NOTexcellent` said "did you mean `excellent`?", which drops the NOT."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("IS NOT excellent", "IS NOTexcellent", 1), "bad.fcl")
+    assert info.value.hint == "`NOT` and `excellent` are two words: `service is NOT excellent`"
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("if a is low and", "if a is verylow and"), "bad.fll")
+    assert info.value.hint == "`very` and `low` are two words: `a is very low`"
+
+
+@pytest.mark.parametrize("old, new, at, hint", [
+    # a keyword split in two: "unexpected `END`" with "did you mean `AND`?"
+    ("END_RULEBLOCK", "END RULEBLOCK", "END", "`END RULEBLOCK` is one word: `END_RULEBLOCK`"),
+    ("VAR_INPUT", "VAR INPUT", "VAR", "`VAR INPUT` is one word: `VAR_INPUT`"),
+    ("END_FUZZIFY", "END FUZZIFY", "END", "`END FUZZIFY` is one word: `END_FUZZIFY`"),
+    # `END` read as a variable's name, the error at `VAR`
+    ("\tfood : REAL;\nEND_VAR", "\tfood : REAL;\nEND VAR", "VAR",
+     "`END VAR` is one word: `END_VAR`"),
+    # `FUNCTION` began a formula that ran to the next `;`, lines on, all of it "unexpected"
+    ("FUNCTION_BLOCK tipper", "FUNCTION BLOCK tipper", "FUNCTION",
+     "`FUNCTION BLOCK` is one word: `FUNCTION_BLOCK`"),
+    # the `_` left out: `ENDVAR` was a variable's name, the error at the next line
+    ("\tfood : REAL;\nEND_VAR", "\tfood : REAL;\nENDVAR", "VAR_OUTPUT",
+     "`ENDVAR` is read as a name: did you mean `END_VAR`?"),
+])
+def test_fcl_a_keyword_split_in_two_is_said_as_one_word(old: str, new: str, at: str,
+                                                       hint: str) -> None:
+    assert old in FCL, old
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace(old, new, 1), "bad.fcl")
+    assert (info.value.message, info.value.hint) == (f"unexpected `{at}`", hint)
+    assert info.value.render().splitlines()[2].strip() == "^" * len(at)
 
 
 def test_fcl_punctuation_is_quoted() -> None:

@@ -155,3 +155,56 @@ def test_a_number_written_with_a_unit_gets_a_hint(written, hint):
                               units="the numbers are in inches")
     assert info.value.message == f"`a` must be a number, not `{written}`"
     assert info.value.hint == hint
+
+
+FIGURE4 = (Path(__file__).parent.parent / "worlds" / "figure4.yaml").read_text()
+
+
+@pytest.mark.parametrize("old, new, line, message, hint", [
+    # a block key glued to its value is one plain word: the error fell at its line, or at the
+    # next key (`name:figure4` then `seed: 3`), in words that did not say why
+    ("seed: 3", "seed:3", 6, "invalid YAML: a line that is neither `key: value` nor `- item`",
+     "`seed:3` (line 6) is one word to YAML: a key's `:` needs a space after it, `seed: 3`"),
+    ("name: figure4", "name:figure4", 6, "invalid YAML: a `:` where no new key can start",
+     "`name:figure4` (line 5) is one word to YAML: a key's `:` needs a space after it, "
+     "`name: figure4`"),
+    ("    - points:", "    -points:", 30, "invalid YAML: this line's indentation matches no",
+     "`-points:` (line 29) is one word to YAML: a list item's `-` needs a space after it, "
+     "`- points:`"),
+    # in a flow mapping `{length:24}` is the key `length:24` (with no value)
+    ("{length: 24, width: 18}", "{length:24, width: 18}", 15,
+     "unknown key `length:24` in robot footprint", "YAML reads `length:24` as one key: a "
+     "key's `:` needs a space after it, `length: 24`"),
+    ("{x: 30, y: -12, heading: 0}", "{x: 30, y:-12, heading: 0}", 24,
+     "unknown key `y:-12` in q_init", "YAML reads `y:-12` as one key: a key's `:` needs a "
+     "space after it, `y: -12`"),
+    ("route: {replan: never}", "route:\n  replan:never", 33,
+     "route must be a mapping (`key: value` lines)", "YAML reads `replan:never` as one key: "
+     "a key's `:` needs a space after it, `replan: never`"),
+    ("{name: A, shape: circle,", "{name: A, shape:circle,", 35,
+     "unknown key `shape:circle` in obstacle 1", "YAML reads `shape:circle` as one key: a "
+     "key's `:` needs a space after it, `shape: circle`"),
+])
+def test_a_key_glued_to_its_value_is_named_in_the_hint(old, new, line, message, hint):
+    from mitos_cli.errors import WorldError
+    from mitos_cli.sim.worldfile import parse_world
+
+    assert old in FIGURE4, old
+    with pytest.raises(WorldError) as info:
+        parse_world(FIGURE4.replace(old, new, 1), "w.yaml")
+    err = info.value
+    assert err.span.line == line and err.message.startswith(message), err.render()
+    assert err.hint == hint
+
+
+def test_a_required_key_glued_to_its_value_is_named_in_the_hint():
+    """`{shape:triangle, ...}` said "missing `shape`" and "add `shape: ...`", which is there."""
+    from mitos_cli.lang.termfile import parse_termset
+
+    text = ("variables:\n  x:\n    role: input\n    universe: [0, 1]\n    terms:\n"
+            "      A: {shape:triangle, points: [0, 0.5, 1]}\n")
+    with pytest.raises(TermSetError) as info:
+        parse_termset(text, "t.yaml")
+    assert (info.value.message, info.value.hint) == (
+        "missing `shape` in term `x.A`", "YAML reads `shape:triangle` as one key: a key's `:` "
+        "needs a space after it, `shape: triangle`")

@@ -130,7 +130,11 @@ def _glued(name: str, text: str) -> str | None:
             return None
         return (f"inputs are apart with spaces only: write `{name}={bare}`, without "
                 f"`{text[len(bare):].strip()}`") if bare != text else None
-    words = [w for w in re.split(r"[,;\s]+", f"{name}={text}") if w]
+    # `road=78size=45`: the next input's name begins where the number ends
+    spaced = re.sub(r"(?<=[\d.])(?=[A-Za-z_][\w\-]*=)", " ", f"{name}={text}")
+    words = [w for w in re.split(r"[,;\s]+", spaced) if w]
+    if len(words) < 2:
+        return None
     return "give each input as a word of its own, apart with spaces: `" + " ".join(words) + "`"
 
 

@@ -211,10 +211,19 @@ def _check_header(header: list[str], text: str, path: str, inputs: tuple[str, ..
                                  "separated by commas",
                                  hint="save the file as CSV with `,` between the values")
     others = [h for h in header if h not in inputs]
+    for h in others:
+        joined = _names_in(h.strip(), inputs)
+        if joined is not None and len(joined) > 1 and set(joined) & set(missing):
+            # `road size` or `roadsize`: two names in one column, without the comma
+            raise InputError("the batch CSV has no column for " + ", ".join(missing),
+                             span=_span(text, path, starts[header.index(h)]),
+                             expected="columns " + ", ".join(inputs),
+                             hint=f"column `{h}` names {_and(joined)}: columns are separated "
+                                  f"by commas, `{','.join(joined)}`")
     close = {k: closest(k, others) for k in missing}
     typos = [(k, h) for k, h in close.items() if h is not None]
     if typos:
-        names = ", ".join(f"`{h}`" for _, h in typos)
+        names = ", ".join(dict.fromkeys(f"`{h}`" for _, h in typos))
         meant = ", ".join(f"`{k}`" for k, _ in typos)
         column = "column" if len(typos) == 1 else "columns"
         raise InputError("the batch CSV has no column for " + ", ".join(missing),
@@ -225,6 +234,30 @@ def _check_header(header: list[str], text: str, path: str, inputs: tuple[str, ..
                               f"you mean {meant}?")
     raise InputError("the batch CSV has no column for " + ", ".join(missing),
                      span=_span(text, path, 0), expected="a header naming " + ", ".join(inputs))
+
+
+def _and(names: Sequence[str]) -> str:
+    quoted = [f"`{n}`" for n in names]
+    return ", ".join(quoted[:-1]) + " and " + quoted[-1]
+
+
+def _names_in(cell: str, names: Sequence[str]) -> list[str] | None:
+    """``cell`` read as ``names`` written one after another, with or without blanks between
+    (``road size``, ``roadsize`` -> road, size), or None when it is not."""
+    ways: dict[int, list[str]] = {0: []}
+    for at in range(len(cell) + 1):
+        if at not in ways:
+            continue
+        if at == len(cell):
+            return ways[at]
+        rest = cell[at:]
+        if rest[0].isspace():
+            ways.setdefault(at + len(rest) - len(rest.lstrip()), ways[at])
+            continue
+        for name in names:
+            if rest.startswith(name):
+                ways.setdefault(at + len(name), [*ways[at], name])
+    return None
 
 
 def _convert(rows: Callable[[], list[list[str]]], columns: list[Sequence[str]], done: int,
@@ -284,8 +317,11 @@ def _bad_row(rows: list[list[str]], done: int, header: list[str], order: list[in
         row = done + i
         if len(cells) != width:
             line = _record_line(text, row)
+            trailing = len(cells) == width - 1 and not header[-1].strip()
             return InputError(f"row has {plural(len(cells), 'value')}, the header {width}",
-                              span=_span(text, path, _line_offset(text, line)))
+                              span=_span(text, path, _line_offset(text, line)),
+                              hint="the header ends in `,`: its last column has no name; "
+                                   "delete that comma" if trailing else None)
         for c in order:
             cell = cells[c]
             if not cell.strip():

@@ -103,7 +103,8 @@ def table_lookup(table: dict, fmt: int, name: str, what: str, span: Span | None,
         return FCL_ALIASES[name.upper()]
     if fmt == FIS and FIS_ALIASES.get(name) in table:
         return FIS_ALIASES[name]
-    pool = [n[fmt] for n in table.values() if n[fmt] is not None]
+    # (each once: MATLAB's and jFuzzyLogic's bisectors are FCL's `COA` as fuzzylite's is)
+    pool = list(dict.fromkeys(n[fmt] for n in table.values() if n[fmt] is not None))
     why = UNSUPPORTED_NORMS.get(name) or (UNSUPPORTED_NORMS.get(name.upper()) if fmt == FCL
                                           else None)
     if why:
@@ -251,9 +252,12 @@ def fuzzylite_term(name: str, kind: str, values: list[float], n_inputs: int,
                           f"supported", span=span,
                           hint="replace it by one of the shapes: " + ", ".join(FUZZYLITE_SHAPES))
     if kind not in FUZZYLITE_SHAPES:
+        glued = [k for k in FUZZYLITE_SHAPES if name.endswith(k) and len(name) > len(k)]
+        hint = did_you_mean(kind, FUZZYLITE_SHAPES) or (
+            f"`{name}` is read as the term's name: `{name[:-len(glued[0])]}` and `{glued[0]}` "
+            f"are two words" if glued else None)        # `term: lowTriangle 0 1 2`
         raise FormatError(f"term `{name}`: unknown term type `{kind}`", span=span,
-                          expected="one of " + ", ".join(FUZZYLITE_SHAPES),
-                          hint=did_you_mean(kind, FUZZYLITE_SHAPES))
+                          expected="one of " + ", ".join(FUZZYLITE_SHAPES), hint=hint)
     shape, count = FUZZYLITE_SHAPES[kind]
     height = 1.0
     if shape == "linear":

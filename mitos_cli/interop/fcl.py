@@ -50,6 +50,7 @@ from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
+from ..lang.lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from ..lang.model import And, Behavior, Expr, Not, Or, Prop, Rule, RuleBase, format_consequent
 from ..lang.terms import Role, Term, TermSet, Variable, first_at
 from ..words import plural
@@ -96,7 +97,8 @@ def read_fcl(path: str | Path) -> RuleBase:
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatError:
     """Lark's exception in FCL's own words: keywords as FCL writes them (``END_FUZZIFY``),
-    and "did you mean" for a word that is a misspelt keyword (``TREM``, ``END_FUZIFY``)."""
+    "did you mean" for a word that is a misspelt keyword (``TREM``, ``END_FUZIFY``), and
+    "two words" for the word before the error read as one name (``poorTHEN``)."""
     line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
     end_column = None
     hint = None
@@ -107,21 +109,44 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
         line, column = len(lines), len(lines[-1]) + 1
         what = "unexpected end of file"
     elif isinstance(exc, UnexpectedToken):
-        what = f"unexpected `{exc.token}`"
-        end_column = column + len(str(exc.token))
+        # (a FUNCTION term's formula runs to the next `;`: `FUNCTION BLOCK` took lines)
+        shown = str(exc.token).split()[0] if exc.token.type == "FORMULA" else str(exc.token)
+        what = f"unexpected `{shown}`"
+        end_column = column + len(shown)
         if exc.interactive_parser is not None:      # `expected` may hold LALR's merged states
             expected = set(exc.interactive_parser.accepts()) or expected
-        if exc.token.type == "NAME":                # a word where a keyword stands
+        keywords = set(_keywords(t.name for t in parser().terminals))
+        if exc.token.type in ("NAME", "FORMULA"):   # `END RULEBLOCK`: one word, split
+            after = re.match(r"[ \t]+([A-Za-z_]\w*)", text[exc.token.start_pos + len(shown):]
+                             if exc.token.start_pos is not None else "")
+            joined = f"{shown}_{after.group(1)}".upper() if after else ""
+            if joined in keywords:
+                hint = f"`{shown} {after.group(1)}` is one word: `{joined}`" if after else None
+        if hint is None and exc.token.type == "NAME":   # a word where a keyword stands
             hint = did_you_mean(str(exc.token), _keywords(expected))
+        before = (exc.token_history or [None])[-1]
+        if hint is None and before is not None and before.type == "NAME" \
+                and f"{before}_{shown}".upper() in keywords:      # `END VAR`, `END` a name
+            hint = f"`{before} {shown}` is one word: `{f'{before}_{shown}'.upper()}`"
+        if hint is None and before is not None and before.type == "NAME":
+            hint = read_as_one_name(str(before), set(_keywords(expected)), keywords,
+                                    fold=str.upper) or _underscore_dropped(str(before),
+                                                                           keywords)
     elif isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
         what = f"unexpected character `{char}`"
     else:
         what = "cannot read this"
-    words = sorted({_word(e) for e in expected})
     return FormatError(what, span=Span.in_text(text, path, line, column, end_column),
-                       expected=("one of " + ", ".join(words)) if words else None, hint=hint)
+                       expected=_expected(expected), hint=hint)
+
+
+def _underscore_dropped(name: str, keywords: set[str]) -> str | None:
+    """``ENDVAR`` read as a variable's name before the error: a keyword without its `_`."""
+    written = next((k for k in keywords if "_" in k and k.replace("_", "") == name.upper()),
+                   None)
+    return f"`{name}` is read as a name: did you mean `{written}`?" if written else None
 
 
 #: option keys (one terminal, OPTION_KEY) as FCL writes them
@@ -163,13 +188,46 @@ def _word(terminal: str) -> str:
     return literal if literal.replace("_", "").isalpha() else f"`{literal}`"
 
 
+def _parse(text: str, path: str | None) -> Tree:
+    """``text``'s parse tree, or its syntax error; a keyword glued to the next word
+    (``IF dist ISlo``, ``WITH0.5``) is refused at the word, as jFuzzyLogic refuses it."""
+    try:
+        return parse_apart(parser(), text)
+    except Glued as glued:
+        raise _glued_error(glued, text, path) from None
+    except UnexpectedInput as exc:
+        raise _syntax_error(exc, text, path) from None
+
+
+def _glued_error(glued: Glued, text: str, path: str | None) -> FormatError:
+    """A keyword glued to the next word (``ISlo``) said at the word: what could stand there,
+    and "two words" when what follows the keyword may follow it, else "did you mean" the
+    keyword (``END_RULEBLOCKx``)."""
+    first, second = glued.first, glued.second
+    word = text[first.start_pos:second.end_pos]
+    expected = accepted_before(parser(), text, first)
+    keyword = first.type == "OPTION_KEY" or (_literal(first.type) or "1").replace("_", "")\
+        .isalpha()
+    hint = None
+    if keyword and glued.fits:
+        hint = f"`{first}` and `{second}` are two words: `{first} {second}`"
+    elif keyword:
+        hint = did_you_mean(word, _keywords(expected))
+    line, column = first.line or 1, first.column or 1
+    end = column + len(word) if "\n" not in word else None
+    return FormatError(f"unexpected `{word}`", span=Span.in_text(text, path, line, column, end),
+                       expected=_expected(expected), hint=hint)
+
+
+def _expected(terminals: set[str]) -> str | None:
+    words = sorted({_word(e) for e in terminals})
+    return ("one of " + ", ".join(words)) if words else None
+
+
 @without_cyclic_gc
 def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     """Read FCL ``text`` into a rule base (one behavior, ``main``)."""
-    try:
-        tree = parser().parse(text)
-    except UnexpectedInput as exc:
-        raise _syntax_error(exc, text, path) from None
+    tree = _parse(text, path)
 
     def span_of(node: Node) -> Span:
         if isinstance(node, Token):

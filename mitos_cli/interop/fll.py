@@ -31,13 +31,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from lark import Lark, Tree
-from lark.exceptions import UnexpectedInput
+from lark.exceptions import UnexpectedInput, UnexpectedToken
 
 from ..errors import FormatError, Span, did_you_mean
 from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.cache import lark_parser
+from ..lang.lexing import Glued, accepted_before, parse_apart, read_as_one_name
 from ..lang.model import Rule, RuleBase, Setting
 from ..lang.model import format_number as _fmt_weight
 from ..lang.terms import Role, Term, Variable
@@ -48,6 +49,8 @@ from .ruletree import expression
 from .text import read_foreign_file
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
     from ..lang.operators import Operators
     from .ruletree import Node, SpanOf
 
@@ -226,9 +229,13 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
             raise FormatError(f"`{key}` before any section", span=span,
                               expected="Engine:, InputVariable:, OutputVariable: or RuleBlock:")
         if key not in KEYS[section]:
+            joined = "".join(key.split())
+            split = next((k for k in (*SECTIONS, *KEYS[section]) if k in (joined, "-".join(
+                key.split()))), None) if joined != key else None      # `Input Variable`
             raise FormatError(f"unknown {section} key `{key}`", span=span,
                               expected="one of " + ", ".join(KEYS[section]),
-                              hint=did_you_mean(key, KEYS[section]))
+                              hint=f"`{key}` is one word: `{split}`" if split else
+                              did_you_mean(key, KEYS[section]))
         if key == "description":
             if current is not None:
                 current.description = value
@@ -449,14 +456,35 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
         return Span.in_text(text, path, lineno, vcol + column - 1, vcol + end - 1)
 
     try:
-        tree = rule_parser().parse(value)
+        tree = parse_apart(rule_parser(), value)
+    except Glued as glued:
+        # `if a isLow`, `then b is HIGHwith 0.5`: fuzzylite splits a rule at its blanks
+        first, second = glued.first, glued.second
+        word = value[first.start_pos:second.end_pos]
+        keyword = first.type not in ("NAME", "NUMBER", "WORD")
+        hint = f"`{first}` and `{second}` are two words: `{first} {second}`" \
+            if keyword and glued.fits else None
+        column = first.column or 1
+        raise FormatError(f"unexpected `{word}`", span=Span.in_text(
+            text, path, lineno, vcol + column - 1, vcol + column - 1 + len(word)),
+            expected=_rule_words(accepted_before(rule_parser(), value, first)),
+            hint=hint) from None
     except UnexpectedInput as exc:
         column = getattr(exc, "column", 1) or 1
         expected = getattr(exc, "expected", None) or getattr(exc, "allowed", None)
+        hint = None
+        if isinstance(exc, UnexpectedToken):
+            if exc.interactive_parser is not None:  # `expected` may hold LALR's merged states
+                expected = set(exc.interactive_parser.accepts()) or expected
+            if exc.token.type == "$END":          # said after the rule, not at its last word
+                column = len(value.rstrip()) + 1
+            before = (exc.token_history or [None])[-1]
+            if before is not None and before.type == "NAME":     # `is HIGHwith 0.5`
+                hint = read_as_one_name(str(before), {str(e).lower() for e in expected or ()},
+                                        _RULE_KEYWORDS)
         raise FormatError("cannot read this rule", span=Span.in_text(
-            text, path, lineno, vcol + column - 1),
-            expected=("one of " + ", ".join(sorted(str(e).lower() for e in expected)))
-            if expected else None) from None
+            text, path, lineno, vcol + column - 1), expected=_rule_words(expected),
+            hint=hint) from None
     antecedent_tree, *rest = tree.children
     weight_token = rest[-1]
     conclusions = [c for c in rest[:-1] if isinstance(c, Tree)]   # all are (the grammar)
@@ -466,6 +494,18 @@ def _rule(value: str, text: str, path: str | None, lineno: int, vcol: int,
     span = Span.in_text(text, path, lineno, vcol, vcol + len(value))
     return Rule(f"r{index + 1}", antecedent, conclusions_of(conclusions, span_of),
                 weight, span)
+
+
+#: the keywords of fuzzylite's rules (the hedges are names checked after parsing)
+_RULE_KEYWORDS = {"if", "is", "then", "and", "or", "with"}
+#: how a rule's terminals are named where they are expected (keywords: as written)
+_RULE_WORDS = {"NAME": "a name", "NUMBER": "a number", "WORD": "a hedge", "LPAR": "`(`",
+               "RPAR": "`)`", "$END": "the end of the rule", "<END-OF-FILE>": "the end of the rule"}
+
+
+def _rule_words(terminals: Iterable[str] | None) -> str | None:
+    words = sorted({_RULE_WORDS.get(str(t), str(t).lower()) for t in terminals or ()})
+    return "one of " + ", ".join(words) if words else None
 
 
 def _check_operators(tree: Node, conj: dict, span_of: SpanOf) -> None:

@@ -29,6 +29,7 @@ from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
 from .cache import lark_parser
+from .lexing import Glued, accepted_before, one_word, parse_apart, read_as_one_name
 from .model import And, Behavior, Consequent, Expr, Not, Or, Prop, Rule, Setting, Use
 
 if TYPE_CHECKING:
@@ -162,6 +163,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
     cut = _operators_cut_short(text, path, token.line)
     if cut is not None:
         return cut
+    glued_name = _glued_name(exc, text, path)
+    if glued_name is not None:
+        return glued_name
     stray = _stray_label(exc, text, path)
     if isinstance(stray, RuleSyntaxError):
         return stray
@@ -452,6 +456,54 @@ def _after_connective(text: str, token: Token) -> bool:
                      text[:token.start_pos]) is not None
 
 
+#: the keywords that join (a word glued to one of them is read as one name: `WIDEand`)
+_JOINING = ("and", "or", "then", "with", "when")
+
+
+def _glued_name(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyntaxError | None:
+    """The error at or after a name that is a term glued to a joining keyword, said with
+    :func:`glued_name_hint`."""
+    token = exc.token
+    hint = glued_name_hint(text, token)
+    if hint is None or token.line is None or token.column is None:
+        return None
+    span = Span.in_text(text, path, token.line, token.column,
+                        token.column + max(1, len(str(token.value))))
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(exc.expected), hint=hint)
+
+
+def glued_name_hint(text: str, token: Token) -> str | None:
+    """A hint for the error at ``token`` when it or a word just before it is a term glued to a
+    joining keyword (``road is WIDEand size ...``, ``speed is SLOWwith 0.5``) or such a keyword
+    glued to the word after a term (``road is WIDE andsize is ...``, ``steering is RS andspeed
+    is ...``): one name to the lexer, and the error said only what was expected there (or,
+    for ``andspeed is``, that ``andspeed`` was a new rule's label without its ``:``)."""
+    lines = text.splitlines()
+    if token.type == "$END" or token.line is None or token.column is None \
+            or token.line > len(lines):
+        return None
+    words = lines[token.line - 1][:token.column - 1].split()
+    if token.type == "NAME":
+        words.append(str(token))
+    modifiers = {"is", "not", *HEDGE_NAMES}
+    for i in range(len(words) - 1, max(len(words) - 3, 0), -1):
+        word = words[i]
+        if not re.fullmatch(r"[A-Za-z_][\w\-]*", word) or word in RESERVED:
+            continue
+        if words[i - 1] in modifiers:           # a term: `WIDEand`
+            hint = read_as_one_name(word, set(_JOINING), set(_JOINING))
+            if hint is not None:
+                return hint
+        elif i >= 2 and words[i - 2] in modifiers:      # after a term: `andsize`
+            said = next((k for k in _JOINING if word.startswith(k) and len(word) > len(k)
+                         and (word[len(k)].isalpha() or word[len(k)] == "_")), None)
+            if said is not None:
+                return (f"`{word}` is read as one name: `{said}` and `{word[len(said):]}` are "
+                        f"two words")
+    return None
+
+
 def _word_before(text: str, token: Token) -> str:
     """The word just before ``token`` on its line (for hints)."""
     lines = text.splitlines()
@@ -662,19 +714,71 @@ MAX_NESTING = 100
 
 def parse_tree(text: str, path: str | None = None, start: str = "start") -> Tree:
     try:
-        tree = parser().parse(text, start=start)
+        tree = parse_apart(parser(), text, start=start,
+                           apart=lambda a, b: keyword_glued(a, b, parser()))
+    except Glued as glued:
+        raise glued_error(glued, text, path, parser(), start) from None
     except UnexpectedInput as exc:
         raise syntax_error(exc, text, path) from None
     check_nesting(tree, text, path)
     check_modifiers(tree, text, path)
-    check_glued_is(tree, text, path)
     return tree
 
 
-#: `is` at the start of a longer word (`road isWIDE`): where only `is` may follow a variable's
-#: name, the lexer takes the keyword off the front of the word and reads the rest as the next
-#: word (`isWIDE` was `is WIDE`, `iss WIDE` the term `s` and then an error at `WIDE`)
-_GLUED_IS = re.compile(r"(?<![\w-])is\w")
+def glued_error(glued: Glued, text: str, path: str | None, parser: Lark, start: str,
+                words: Callable[[Iterable[str]], str | None] | None = None
+                ) -> RuleSyntaxError:
+    """A keyword glued to the word after it (``r1: ifroad is ...``, ``with0.5``, ``adapt
+    epochs50``), which the lexer read as the keyword and the word: said at the word, with what
+    could stand there (``words`` names the terminals) and "two words" (``road isWIDE`` as
+    `_glued_is_error` says it), or "did you mean" the keyword (``iff``, ``thenn``)."""
+    first, second = glued.first, glued.second
+    start_pos, end_pos = first.start_pos or 0, second.end_pos or 0
+    word = text[start_pos:end_pos]
+    # `iff`, `iss`, `ifff`: a keyword and a letter, or its last letter again, is misspelt
+    typo = str(second).isalpha() and (len(str(second)) == 1 or
+                                      set(str(second).lower()) == {str(first)[-1:].lower()})
+    if first.type == "IS" and glued.fits:
+        var = re.search(r"([A-Za-z_][\w\-]*)\s*$", text[:start_pos])
+        return _glued_is_error(text, path, var.group(1) if var else "x", start_pos, end_pos,
+                               None if typo else str(second))
+    expected = accepted_before(parser, text, first, start)
+    keywords = [e.lower() for e in expected if e.isupper() and e.isalpha() and e != "NAME"]
+    said = next((k for k in keywords if word.startswith(k) and len(word) > len(k)), None)
+    hint = None
+    if typo:
+        hint = did_you_mean(word, keywords)
+    elif glued.fits and (_keyword(parser, first) or _keyword(parser, second)):
+        hint = f"`{first}` and `{second}` are two words: `{first} {second}`"
+    elif said is not None:          # `with0.5`: the name `with0`, then `.5`
+        hint = f"`{said}` and `{word[len(said):]}` are two words: `{said} {word[len(said):]}`"
+    elif not glued.fits:
+        hint = did_you_mean(word, keywords)
+    line, column = first.line or 1, first.column or 1
+    return RuleSyntaxError(f"unexpected `{word}`",
+                           span=Span.in_text(text, path, line, column, column + len(word)
+                                             if "\n" not in word else None),
+                           expected=(words or _expected)(expected), hint=hint)
+
+
+def keyword_glued(first: Token, second: Token, parser: Lark) -> bool:
+    """A keyword of ``parser`` cut out of one word with what touches it (``ifroad``,
+    ``with0.5``): names are ASCII, and a number glued to a name (``90x``) is said by
+    :func:`syntax_error`."""
+    return one_word(first, second) and str(first)[-1:].isascii() and \
+        str(second)[:1].isascii() and (_keyword(parser, first) or _keyword(parser, second))
+
+
+def _keyword(parser: Lark, token: Token) -> bool:
+    """Whether ``token`` is a keyword of ``parser``'s grammar (``if``, ``seed``), as opposed to
+    a name, a number or a file name."""
+    from lark.lexer import PatternStr
+
+    return any(t.name == token.type and isinstance(t.pattern, PatternStr)
+               and t.pattern.value.isalpha() for t in parser.terminals)
+
+
+#: `road iss WIDE`, read as `road is s` and then "unexpected `WIDE`"
 _GLUED_BEFORE = re.compile(r"(?<![\w-])([A-Za-z_][\w-]*)[ \t]+(is\w[\w-]*)\s*$")
 
 
@@ -689,31 +793,6 @@ def _glued_is_error(text: str, path: str | None, var: str, start: int, end: int,
     return RuleSyntaxError(f"unexpected `{word}`",
                            span=Span.in_text(text, path, line, column, column + len(word)),
                            expected="`is`", hint=hint)
-
-
-def check_glued_is(tree: Tree, text: str, path: str | None) -> None:
-    """Refuse ``road isWIDE`` (and ``speed is90``, ``road isnot WIDE``), which the lexer
-    read as ``road is WIDE``: `is` is a word of its own, as every keyword is elsewhere."""
-    if _GLUED_IS.search(text) is None:
-        return                            # the usual case: no walk
-    glued = []
-    for node in _subtrees(tree):
-        if node.data not in ("proposition", "term_consequent", "crisp_consequent"):
-            continue
-        var, after = node.children[0], node.children[1]
-        while isinstance(after, Tree):
-            after = after.children[0]
-        if not isinstance(var, Token) or not isinstance(after, Token) \
-                or var.end_pos is None or after.start_pos is None:
-            continue
-        start = after.start_pos - 2
-        if start >= var.end_pos and text[start:after.start_pos] == "is" \
-                and (str(after)[:1].isalnum() or str(after)[:1] == "_"):
-            glued.append((start, var, after))
-    if glued:
-        start, var, after = min(glued, key=lambda g: g[0])
-        raise _glued_is_error(text, path, str(var), start, after.end_pos or start + 2,
-                              str(after))
 
 
 #: what ``then y is not A`` is refused as: (the thing, the hint), or a hint made from its

@@ -329,7 +329,11 @@ def _variable(name: str, role: str, variables: dict[str, Variable], span: Span |
     v = variables.get(name)
     if v is None:
         pool = [n for n, var in variables.items() if var.role == role]
-        raise unknown(f"{role} variable", name, pool, span=span)
+        error = unknown(f"{role} variable", name, pool, span=span)
+        if role == "input" and name[:3].lower() == "not" and name[3:] in pool:
+            # `if notroad is WIDE`: "did you mean `road`?" dropped the `not`
+            error.hint = f"`{name[:3]}` and `{name[3:]}` are two words"
+        raise error
     if v.role != role:
         where = "a condition" if role == "input" else "an action"
         raise RuleBaseError(f"`{name}` is an {v.role} variable and cannot appear in {where}",

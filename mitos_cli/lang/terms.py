@@ -207,8 +207,23 @@ class Variable:
     def term(self, name: str, span: Span | None = None) -> Term:
         found = self._by_name.get(name)
         if found is None:
-            raise unknown("term", name, self.term_names, span=span, owner=self.name)
+            error = unknown("term", name, self.term_names, span=span, owner=self.name)
+            error.hint = self._modifier_glued(name) or error.hint
+            raise error
         return found
+
+    def _modifier_glued(self, name: str) -> str | None:
+        """``notTIGHT``, ``veryWIDE``: `not` or a hedge glued to a term is one name; "did you
+        mean `TIGHT`?" would drop the `not` (and turn the condition over)."""
+        from ..fuzzy.hedges import HEDGES, fuzzylite_names
+
+        lowered = name.lower()
+        for word in sorted({"not", *HEDGES, *fuzzylite_names()}, key=len, reverse=True):
+            rest = name[len(word):]
+            if lowered.startswith(word) and rest in self._by_name:
+                said = name[:len(word)]
+                return f"`{said}` and `{rest}` are two words: `{self.name} is {said} {rest}`"
+        return None
 
     def index(self, name: str) -> int:
         return self.term_names.index(name)

@@ -242,7 +242,9 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
         mark = (exc.context_mark if at_start else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
         problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
-        raise error(f"invalid YAML: {problem}", span=span, expected=expected) from None
+        hint = glued_hint(text, mark.line + 1) if mark is not None else None
+        raise error(f"invalid YAML: {problem}", span=span, expected=expected, hint=hint) \
+            from None
     except yaml.reader.ReaderError as exc:       # a character YAML does not allow
         pos = min(exc.position, len(text))
         line = text.count("\n", 0, pos) + 1
@@ -252,6 +254,39 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
                     span=Span.at(text, path, pos, line, column)) from None
     except yaml.YAMLError as exc:  # pragma: no cover - other YAML errors carry no mark
         raise error(f"invalid YAML: {exc}", span=Span(path, 1, 1)) from None
+
+
+#: a key glued to its value (`seed:3`, `- radius:9`): YAML reads `seed:3` as one plain word
+_GLUED_KEY = re.compile(r"^[ \t]*(?:-[ \t]+)?([A-Za-z_][\w.-]*):([^\s:/\\#'\"][^#]*?)[ \t]*"
+                        r"(?:#.*)?$")
+#: a list item's `-` glued to the item (`-points:`, `-{name: A}`): YAML reads a plain word
+_GLUED_DASH = re.compile(r"^[ \t]*-([\[{A-Za-z_][^#]*?)[ \t]*(?:#.*)?$")
+
+
+def glued_hint(text: str, line: int) -> str | None:
+    """A hint for a YAML error at ``line`` (1-based) when that line or one of the two above
+    glues a key to its value (``seed:3``: YAML reads one word, and the error falls where a key
+    was due, or a line later) or a list's `-` to its item (``-points:``)."""
+    lines = text.splitlines()
+    for i in range(min(line, len(lines)) - 1, max(line - 4, -1), -1):
+        key = _GLUED_KEY.match(lines[i])
+        if key:
+            value = key.group(2) if len(key.group(2)) <= 24 else key.group(2).split()[0]
+            return (f"`{key.group(1)}:{value}` (line {i + 1}) is one word to YAML: a key's "
+                    f"`:` needs a space after it, `{key.group(1)}: {value}`")
+        dash = _GLUED_DASH.match(lines[i])
+        if dash:
+            word = dash.group(1).split()[0]
+            return (f"`-{word}` (line {i + 1}) is one word to YAML: a list item's `-` needs a "
+                    f"space after it, `- {word}`")
+    return None
+
+
+def _glued_key(key: object) -> str | None:
+    """``length:24`` as a key (YAML's reading of ``{length:24}``): a hint to write the space."""
+    match = re.fullmatch(r"([A-Za-z_][\w.-]*):(\S.*)", key) if isinstance(key, str) else None
+    return (f"YAML reads `{key}` as one key: a key's `:` needs a space after it, "
+            f"`{match.group(1)}: {match.group(2)}`") if match else None
 
 
 def unclosed_flow(exc: yaml.MarkedYAMLError, text: str, path: str | None,
@@ -376,20 +411,23 @@ def check_keys(mapping: YMap, allowed: Iterable[str], error: type[MitosError],
         if key not in allowed:
             raise error(f"unknown key `{key}` in {what}", span=mapping.key_span(key),
                         expected="one of " + ", ".join(allowed),
-                        hint=did_you_mean(key, allowed))
+                        hint=_glued_key(key) or did_you_mean(key, allowed))
 
 
 def require(mapping: YMap, key: str, error: type[MitosError], what: str) -> Any:
     """The value of ``key``, or ``error`` naming the mapping's line when it is missing."""
     if key not in mapping:
+        glued = next((k for k in mapping if isinstance(k, str) and k.startswith(f"{key}:")),
+                     None)                         # `{shape:triangle, ...}`
         raise error(f"missing `{key}` in {what}", span=mapping.span,
-                    hint=f"add `{key}: ...` to {what}")
+                    hint=_glued_key(glued) or f"add `{key}: ...` to {what}")
     return mapping[key]
 
 
 def expect_map(value: Any, span: Span, error: type[MitosError], what: str) -> YMap:
     if not isinstance(value, YMap):
-        raise error(f"{what} must be a mapping (`key: value` lines)", span=span)
+        raise error(f"{what} must be a mapping (`key: value` lines)", span=span,
+                    hint=_glued_key(value))         # `route:` and `  replan:never` below
     return value
 
 

@@ -21,6 +21,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ..errors import LessonError, RuleSyntaxError, Span
 from ..lang.cache import lark_parser
+from ..lang.lexing import Glued, parse_apart
 from ..lang.model import Rule, Setting, Use
 from ..lang.parse import (
     TARGETS,
@@ -29,11 +30,13 @@ from ..lang.parse import (
     _hedge_hint,
     _ToModel,
     _unquote,
-    check_glued_is,
     check_modifiers,
     check_nesting,
     check_settings,
+    glued_error,
+    glued_name_hint,
     joined_hint,
+    keyword_glued,
     keyword_hint,
     not_in_action_before,
     shift,
@@ -373,6 +376,12 @@ def _not_a_target(exc: UnexpectedInput, line: str, where: str) -> RuleSyntaxErro
     return found
 
 
+def _keyword_glued(first: Token, second: Token) -> bool:
+    """A keyword cut out of one word (`adapt epochs50`, `seed5`, `plotx.png`), as in a rule
+    file; a time and its unit are one word as written (`at 12.5s`)."""
+    return second.type != "S" and keyword_glued(first, second, parser())
+
+
 def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Command:
     """Parse one command (``line`` may span several lines for a wrapped rule).
 
@@ -385,14 +394,15 @@ def parse_command(line: str, path: str | None = None, lineno: int = 1) -> Comman
         if bad is not None:
             raise bad
         try:
-            tree = parser().parse(line)
+            tree = parse_apart(parser(), line, apart=_keyword_glued)
+        except Glued as glued:
+            raise glued_error(glued, line, where, parser(), "command", _expected) from None
         except UnexpectedInput as exc:
             raise _unknown_command(line, line, where, 1) or _not_a_target(exc, line, where) \
                 or _syntax_error(exc, line, where) from None
         check_nesting(tree, line, where)
         check_modifiers(tree, line, where, TARGETS if "->" in line or
                         line.split()[:1] == ["at"] else None)
-        check_glued_is(tree, line, where)
     except RuleSyntaxError as exc:        # parsed alone: put it at its line of the lesson
         exc.span = shift(exc.span, lineno - 1)
         raise
@@ -435,6 +445,14 @@ def _bad_number(line: str, where: str) -> RuleSyntaxError | None:
     if first == ["at"]:
         found += [(m.start(1), m.group(1), "a time", True) for m in
                   re.finditer(rf"(?:^\s*at|\sto)\s+({_NUMBERISH})", line)]
+        glued = re.match(rf"\s*at\s+\S+\s+(to({_NUMBERISH}))", line)
+        if glued:       # `at 13s to14s ...`: `to14s` was an instruction's word (or a name)
+            column = glued.start(1) + 1
+            return RuleSyntaxError(
+                f"unexpected `{glued.group(1)}`",
+                span=Span.in_text(line, where, 1, column, column + len(glued.group(1))),
+                expected="`to` and the time the window ends",
+                hint=f"`to` and `{glued.group(2)}` are two words: `to {glued.group(2)}`")
     if first == ["adapt"]:
         found += [(m.start(2), m.group(2), f"`{m.group(1)}`", False) for m in
                   re.finditer(rf"\b(epochs|rate)\s+({_NUMBERISH})", line)]
@@ -677,7 +695,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         # a target reuses the rule language's consequent, which a rule's `with` may follow;
         # a target takes no weight, and the line may end after it
         expected = expected - {"WITH"} | {"$END"}
-    hint = _teach_hint(text, token, before) if str(token.value) != ";" else None
+    hint = _teach_hint(text, token, before) or glued_name_hint(text, token) \
+        if str(token.value) != ";" else None
     if hint is not None:
         pass
     elif str(token.value) == ";":          # FCL's `... then speed is SLOW;` (not a hedge)
