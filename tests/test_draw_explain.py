@@ -282,7 +282,7 @@ name: eight
 seed: 2
 dt: 0.05
 time_limit: 8
-robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}}
+robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, give_way: false}
 q_init: {x: 20, y: 0, heading: 0}
 q_goal: {x: 400, y: 300}
 map:
@@ -300,7 +300,8 @@ robots:
 def test_eight_robots_are_told_apart_and_one_collision_place_has_one_label(tmp_path):
     """Of eight robots, `robot` and `r6` were drawn in one blue and `r1` and `r7` in one
     orange, and r3 and r4, which ran into each other 23 in apart, had two labels
-    `collision at 5.05 s` drawn over one another."""
+    `collision at 5.05 s` drawn over one another (the robots do not give way to each other
+    here, as before they could: giving way, none collides)."""
     path = tmp_path / "eight.yaml"
     path.write_text(EIGHT, encoding="utf-8")
     res = simulate(load_world(path))

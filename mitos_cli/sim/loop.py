@@ -36,7 +36,7 @@ from ..errors import CommandError, InputError, WorldError
 from ..numbers import whole_number
 from ..words import clearance as shown_clearance
 from ..words import plural
-from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors
+from . import geometry, kinematics, knowledge, movers, perception, rows, safety, sensors, traffic
 from . import obstacles as obs_mod
 from .geometry import polygon_segments, rect_corners
 from .planner import Percepts, Planner
@@ -602,6 +602,10 @@ class Simulation:
         self._safety = safety.Settings()
         self._brake_reach = [safety.reach_of(r, self.dt, self._safety, sen.range)
                              for r in self.robots]
+        # (traffic) the robots that share their routes and give way, where two or more do
+        self._traffic = [r.give_way for r in self.robots]
+        if sum(self._traffic) < 2:
+            self._traffic = []
         self._still = None
         self._still_discs = None        # discs round the still rectangles (rows.SenseRow)
         if not any(o.motion.kind in ("velocity", "waypoints") for o in world.obstacles):
@@ -617,6 +621,8 @@ class Simulation:
         self._steer = self.limits.straight.copy()
         self._s_hint = np.zeros(n)
         self._active = np.ones(n, dtype=bool)
+        self._ways = traffic.Traffic()                 # (_give_way) who goes first where
+        self._gave_way_at = np.full(n, -self._stuck_window - 1)   # the last tick each did
         self._near_at = [(math.inf, math.inf)] * n     # where each robot's wall set was gathered
         self._near_walls = [np.zeros((0, 4))] * n
         self._near_known = [np.zeros((0, 4))] * n
@@ -1316,6 +1322,8 @@ class Simulation:
         """The robot's own safety on every active robot's command (:mod:`.safety`): the brake,
         and backing out of a pocket when it has held the robot too long; their first sweeps
         measured together (:meth:`.safety.Fleet.guard`)."""
+        if self._traffic:
+            self._give_way(s.command, self._active, self._x, self._y, self._v, self._s_hint)
         fleet = self._fleet
         rows = (self._active & fleet.brakes).nonzero()[0]
         maps = [self._maps[i] for i in rows.tolist()]
@@ -1327,6 +1335,20 @@ class Simulation:
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
         for i in fleet.guard(rows, s.command, self._recovery, now, near):
             self._backed.append((self._k, i))
+
+    def _give_way(self, command: np.ndarray, active: np.ndarray, x: np.ndarray, y: np.ndarray,
+                  speed: np.ndarray, progress: np.ndarray) -> None:
+        """The speeds of ``command [n, 2]`` held to where each robot gives way to another
+        (:mod:`.traffic`), from the robots' ``active``, place (``x``, ``y``), ``speed`` and
+        route ``progress``."""
+        mates = [traffic.Mate(self._routes[i], float(progress[i]), float(x[i]), float(y[i]),
+                              float(speed[i]), r) if share and active[i] else None
+                 for i, (r, share) in enumerate(zip(self.robots, self._traffic))]
+        limit = self._ways.limits(mates, self.dt)
+        held = limit < command[:, 1]
+        if held.any():
+            command[held, 1] = limit[held]
+            self._gave_way_at[held] = self._k
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
@@ -1371,7 +1393,10 @@ class Simulation:
             best[-1], best[-1 - slow] if len(best) > slow else None))
 
     def _stuck(self, stuck: np.ndarray) -> bool:
-        """Whether any robot is ``stuck [n]``; those read ``stuck``."""
+        """Whether any robot is ``stuck [n]``; those read ``stuck``. A robot that gave way
+        to another in the last ``STUCK_TIME`` is waiting, not stuck."""
+        if self._traffic:
+            stuck = stuck & (self._k - self._gave_way_at > self._stuck_window)
         for i in stuck.nonzero()[0]:
             self._outcomes[i] = "stuck"
         return bool(np.count_nonzero(stuck))
@@ -1955,6 +1980,12 @@ class Batch:
         that brake found in one :func:`.knowledge.near_all` (round each sweep's box, a
         quarter of the cells of the robot's square), and the backing-outs given back to each
         robot's run."""
+        x, y, h = self._ticked()
+        v, steer = self._drive
+        for run, (a, b) in zip(self.runs, self.spans):
+            if run._traffic:
+                run._give_way(self.command[a:b], self.active[a:b], x[a:b], y[a:b], v[a:b],
+                              self._hint[a:b])
         fleet = self._fleet
         rows = (self.active & fleet.brakes).nonzero()[0]
         if not len(rows):
@@ -1965,8 +1996,6 @@ class Batch:
             return knowledge.brake_cells_all(maps if len(j) == len(maps) else
                                              [maps[k] for k in j.tolist()], points, half)
 
-        x, y, h = self._ticked()
-        v, steer = self._drive
         backs = fleet.guard(rows, self.command, self._recovery,     # (the runs' too)
                             (x, y, h, steer, v, self.block[_SIDE]), near)
         for row in backs:

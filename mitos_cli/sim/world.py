@@ -48,6 +48,8 @@ class Robot:
     acceleration: float = 40.0     # in/s^2 (also the braking limit)
     max_reverse: float = 15.0      # in/s: the front wheel drives backward too (0: it cannot)
     brake: bool = True             # the emergency brake and backing out (sim/safety.py)
+    give_way: bool = True          # shares its route with the world's other robots and gives
+                                   # way where routes cross (sim/traffic.py)
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 TOP_KEYS = ("name", "seed", "dt", "time_limit", "substeps", "behavior", "robot", "sensors",
             "q_init", "q_goal", "map", "obstacles", "robots", "randomise", "route")
 ROBOT_KEYS = ("model", "wheelbase", "footprint", "safety_margin", "steering", "max_speed",
-              "acceleration", "max_reverse", "brake")
+              "acceleration", "max_reverse", "brake", "give_way")
 STEERING_KEYS = ("min", "max", "straight", "max_rate")
 SENSOR_KEYS = ("layout", "count", "fov", "cone", "range", "noise")
 MAP_KEYS = ("corridors", "grid", "unknown", "given")
@@ -224,7 +224,8 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
         max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
         acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
         max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
-        brake=r.flag(m, "brake", "robot", d.brake))
+        brake=r.flag(m, "brake", "robot", d.brake),
+        give_way=r.flag(m, "give_way", "robot", d.give_way))
     _check_turn(m, st, robot)
     if dt is not None:
         _check_tick(m, robot, dt)

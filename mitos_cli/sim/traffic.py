@@ -1,0 +1,254 @@
+"""Robots of one world give way to each other where their routes cross.
+
+Each robot senses the others as it senses a cart: echoes on its sonar. Head-on in a corridor
+that is enough (each keeps right and they pass), but two robots coming to a crossing from two
+sides each avoid the other as if it stood still, swerve into its way and meet in the middle
+(docs/navigation.md, night 8's #12). Robots of one fleet share where they are and the route
+each follows, as real fleets share their traffic (Open-RMF's schedule, a warehouse's fleet
+manager), and give way by the rule of the road:
+
+- the **crossing**: the stretch of each robot's route ahead (from its rear to
+  :data:`LOOK_TIME` of its top speed on) that passes within :func:`zone` of the other's, where
+  the two stretches run at :data:`CROSSING` or more to each other (head-on and one behind the
+  other are the sonar's and the brake's: the robots keep right, and a robot slows for what is
+  ahead of it);
+- **who goes first** is decided where two robots first meet a crossing, and kept until it is
+  behind them (:class:`Traffic`): a robot that can no longer stop short of the crossing, or is
+  in it, is *committed* and goes first; of two committed, the one that comes first to where
+  the routes meet; of none, the one coming from the other's right, unless the other clears
+  the crossing :data:`CLEAR_BY` before it arrives. Four robots each with another on its right
+  wait on each other in a ring; the first of them in the world's order goes;
+- **giving way** is a speed limit, :func:`.safety.brake`'s for the room left before the robot
+  comes within the zone of the other's route and :data:`SLACK` more, measured straight to that
+  route (never more than along its own, whatever a replanning does to either route); a robot
+  already inside stops where it is. It goes on once the other's route, rear included, has
+  left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`).
+
+It is a limit on every planner's command, as the brake is (a user's planner, DWA, a
+Gymnasium action), and it reads only what the robots share, never the world. Each run keeps
+its own :class:`Traffic`, fed the run's own arrays: a run's robots give way the same in any
+batch. ``robot: {give_way: false}`` leaves a robot out (it neither shares nor gives way).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .route import Route
+from .safety import brake
+from .world import Robot
+
+#: in: the distance between two places of a route looked along
+STEP = 4.0
+#: s: how far ahead a robot looks along its route, at its top speed
+LOOK_TIME = 3.0
+#: the least sine of the angle between two routes' stretches near each other that is a
+#: crossing (30 deg)
+CROSSING = 0.5
+#: in/s: a robot is reckoned to move at least this fast when its arrival is timed
+SLOWEST = 10.0
+#: s: a robot that clears the crossing this long before the other arrives need not give way
+CLEAR_BY = 1.0
+#: in: a robot giving way stops this much short of the crossing's edge; it is committed only
+#: when it could not stop short of the edge itself (so braking to give way never commits it)
+SLACK = 12.0
+#: in: how far from its route a robot may drive: its keep-right lane (perception's ``road_cap``
+#: of 100 in, a quarter of it)
+LANE = 25.0
+
+
+class Mate:
+    """What a robot shares with the others of its run: where it is, its speed, and the
+    route it follows (the stretch ahead made only when a crossing is looked for)."""
+
+    def __init__(self, route: Route, progress: float, x: float, y: float, speed: float,
+                 robot: Robot) -> None:
+        self.route, self.progress, self.speed = route, progress, speed
+        self.at = np.array([x, y])
+        self.acceleration = robot.acceleration
+        self.radius = math.hypot(robot.length / 2, robot.width / 2)
+        self.back = robot.length / 2               # in: the path begins at its rear
+        self.reach = max(robot.max_speed, SLOWEST) * LOOK_TIME
+        self._path: np.ndarray | None = None
+
+    def ends(self, k: int) -> bool:
+        """Whether the route ends at or before its path's place ``k`` (the robot stops there:
+        its goal, or a refuge out of a cart's way, is no crossing)."""
+        return self.progress - self.back + k * STEP >= self.route.length
+
+    @property
+    def path(self) -> np.ndarray:
+        """``[K, 2]`` its route from its rear to :attr:`reach` ahead, a place every STEP in."""
+        if self._path is None:
+            ahead = np.arange(-self.back, self.reach + STEP / 2, STEP)
+            self._path = self.route.points_at(np.clip(self.progress + ahead, 0.0,
+                                                      self.route.length))
+        return self._path
+
+
+def zone(a: Mate, b: Mate) -> float:
+    """How near (in) two robots' routes pass for their bodies to meet: their half diagonals,
+    and a lane's width (:data:`LANE`) for how far off their routes the two drive."""
+    return a.radius + b.radius + LANE
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """Where two robots' routes cross, in inches along each from the robot's centre (less
+    than 0: behind it): the first and the last place within :func:`zone`, and the place
+    where the two routes come nearest."""
+
+    enter: tuple[float, float]
+    leave: tuple[float, float]
+    centre: tuple[float, float]
+    right: bool                    # the second robot comes from the first's right
+
+    @property
+    def other(self) -> Crossing:
+        """The same crossing seen from the second robot."""
+        return Crossing(_swap(self.enter), _swap(self.leave), _swap(self.centre), not self.right)
+
+
+def _swap(pair: tuple[float, float]) -> tuple[float, float]:
+    return pair[1], pair[0]
+
+
+def crossing(a: Mate, b: Mate, known: bool = False) -> Crossing | None:
+    """Where the routes of ``a`` and ``b`` cross ahead, or ``None``: apart, or, unless the
+    crossing is ``known`` already, with either robot backing out, with a route ending within
+    :func:`zone` of the other (where the robot will stand: its goal, or a refuge out of a
+    cart's way), or with the two routes' stretches within the zone of each other (each from
+    its first place there to its last) at less than :data:`CROSSING` to each other: head-on
+    or one behind the other, where the stretches run along each other, even where one route
+    swerves round an object for a moment. A known crossing is kept however the routes meet
+    (the routes of two robots going round each other in it may run side by side)."""
+    if math.dist(a.at, b.at) > a.back + a.reach + b.back + b.reach + zone(a, b):
+        return None                                   # (too far apart for their paths to)
+    if not known and min(a.speed, b.speed) < 0:
+        return None
+    d = np.hypot(a.path[:, None, 0] - b.path[None, :, 0], a.path[:, None, 1] - b.path[None, :, 1])
+    near = d < zone(a, b)
+    rows, cols = near.any(axis=1).nonzero()[0], near.any(axis=0).nonzero()[0]
+    if not len(rows):
+        return None
+    sine = _sine(_unit(a.path[rows[-1]] - a.path[rows[0]]),
+                 _unit(b.path[cols[-1]] - b.path[cols[0]]))
+    if not known and (abs(sine) < CROSSING or a.ends(rows[-1]) or b.ends(cols[-1])):
+        return None
+    i, j = (int(k) for k in np.unravel_index(int(np.argmin(d)), d.shape))
+    return Crossing((rows[0] * STEP - a.back, cols[0] * STEP - b.back),
+                    (rows[-1] * STEP - a.back, cols[-1] * STEP - b.back),
+                    (i * STEP - a.back, j * STEP - b.back), sine > 0)
+
+
+def _sine(u: np.ndarray | None, v: np.ndarray | None) -> float:
+    """The sine of the angle from unit vector ``u`` to ``v`` (0 where either is ``None``)."""
+    if u is None or v is None:
+        return 0.0
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
+def _unit(d: np.ndarray) -> np.ndarray | None:
+    """``d`` made a unit vector (``None`` for a stretch of no length: a route's end)."""
+    n = math.hypot(float(d[0]), float(d[1]))
+    return d / n if n > 1e-9 else None
+
+
+def committed(m: Mate, enter: float, dt: float) -> bool:
+    """Whether the robot can no longer stop short of a crossing ``enter`` in ahead (or is in it)."""
+    return enter <= 0 or brake(enter, m.acceleration, 0.0, dt) < m.speed
+
+
+def _time(m: Mate, distance: float) -> float:
+    return distance / max(m.speed, SLOWEST)
+
+
+def first(a: Mate, b: Mate, c: Crossing, dt: float) -> bool:
+    """Whether ``a`` goes first at its crossing ``c`` with ``b``, decided where the two first
+    meet it: a committed robot goes first; of two, the one that comes first to where their
+    routes meet (the one from the right at a tie); of none, the one from the other's right,
+    unless the other clears the crossing :data:`CLEAR_BY` before it arrives."""
+    mine, theirs = committed(a, c.enter[0], dt), committed(b, c.enter[1], dt)
+    if mine != theirs:
+        return mine
+    if mine:
+        ta, tb = _time(a, c.centre[0]), _time(b, c.centre[1])
+        return ta < tb or (ta == tb and not c.right)
+    if c.right:                                     # b from a's right: b goes, unless a is
+        return _time(a, c.leave[0]) + CLEAR_BY <= _time(b, c.enter[1])     # gone by then
+    return not _time(b, c.leave[1]) + CLEAR_BY <= _time(a, c.enter[0])
+
+
+def room(a: Mate, b: Mate) -> float:
+    """How far (in) ``a``, giving way to ``b``, may still drive: until it is :data:`SLACK`
+    outside the crossing, measured straight to ``b``'s route (never more than along its own,
+    which crosses ``b``'s at an angle; and a replanning that moves either route cannot let a
+    robot giving way drive on into the crossing)."""
+    gap = float(np.min(np.hypot(b.path[:, 0] - a.at[0], b.path[:, 1] - a.at[1])))
+    return max(gap - zone(a, b) - SLACK, 0.0)
+
+
+class Traffic:
+    """The robots of one run giving way at crossings: who goes first at each crossing is
+    decided once, where the two first meet it, and kept until it is behind them (decided
+    again each tick, two robots braking for each other took turns going first)."""
+
+    def __init__(self) -> None:
+        self.order: dict[tuple[int, int], int] = {}     # (i, j), i < j -> the one first
+
+    def limits(self, mates: Sequence[Mate | None], dt: float) -> np.ndarray:
+        """Each robot's speed limit (in/s; ``inf`` where it gives way to none) among
+        ``mates`` (``None``: a robot no longer driving or not sharing). Where giving way goes
+        round in a ring (four robots at a crossroads, each with another on its right), the
+        first robot of the ring in the world's order goes."""
+        n = len(mates)
+        gives: list[dict[int, float]] = [{} for _ in range(n)]
+        for i in range(n):
+            for j in range(i + 1, n):
+                a, b = mates[i], mates[j]
+                c = None if a is None or b is None else crossing(a, b, (i, j) in self.order)
+                if c is None or a is None or b is None:
+                    self.order.pop((i, j), None)
+                    continue
+                if (i, j) not in self.order:
+                    self.order[i, j] = i if first(a, b, c, dt) else j
+                if self.order[i, j] == i:
+                    gives[j][i] = room(b, a)
+                else:
+                    gives[i][j] = room(a, b)
+        while (ring := _ring(gives)) is not None:
+            lowest = min(ring)
+            gives[lowest] = {j: r for j, r in gives[lowest].items() if j not in ring}
+        out = np.full(n, np.inf)
+        for i, given in enumerate(gives):
+            m = mates[i]
+            if m is not None and given:
+                out[i] = brake(min(given.values()), m.acceleration, 0.0, dt)
+        return out
+
+
+def _ring(gives: list[dict[int, float]]) -> set[int] | None:
+    """The robots of a ring of giving way (each waits on the next, the last on the first),
+    or ``None``: the first found depth first from the lowest robot, each robot visited once."""
+    state = [0] * len(gives)                    # 0 not yet, 1 on the way being walked, 2 done
+    for start in range(len(gives)):
+        if state[start]:
+            continue
+        way, todo = [start], [iter(sorted(gives[start]))]
+        state[start] = 1
+        while todo:
+            nxt = next(todo[-1], None)
+            if nxt is None:
+                state[way.pop()] = 2
+                todo.pop()
+            elif state[nxt] == 1:
+                return set(way[way.index(nxt):])
+            elif state[nxt] == 0:
+                state[nxt] = 1
+                way.append(nxt)
+                todo.append(iter(sorted(gives[nxt])))
+    return None

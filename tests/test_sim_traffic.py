@@ -1,0 +1,195 @@
+"""Robots of one world give way where their routes cross (:mod:`mitos_cli.sim.traffic`):
+the rule of the road on straight routes, and four robots at a crossroads in the simulator."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mitos_cli.errors import WorldError
+from mitos_cli.sim import traffic
+from mitos_cli.sim.lockstep import run_lockstep
+from mitos_cli.sim.loop import STUCK_TIME, prepare, simulate
+from mitos_cli.sim.planner import FuzzyPlanner
+from mitos_cli.sim.route import Route
+from mitos_cli.sim.world import Robot
+from mitos_cli.sim.worldfile import load_world
+
+DATA = Path(__file__).parent / "data"
+ROBOT = Robot()
+DT = 0.05
+
+
+def driving(x: float, y: float, heading_deg: float, speed: float = 30.0,
+            length: float = 600.0) -> traffic.Mate:
+    """A robot at (x, y) on a straight route of ``length`` in along ``heading_deg``."""
+    h = math.radians(heading_deg)
+    start = (x - 50 * math.cos(h), y - 50 * math.sin(h))
+    end = (x + length * math.cos(h), y + length * math.sin(h))
+    return traffic.Mate(Route.of([start, end]), 50.0, x, y, speed, ROBOT)
+
+
+def limits(*mates: traffic.Mate | None) -> np.ndarray:
+    return traffic.Traffic().limits(list(mates), DT)
+
+
+def test_of_two_robots_coming_to_a_crossing_the_one_with_the_other_on_its_right_gives_way():
+    east = driving(-150, 0, 0)         # eastbound, 150 in before the crossing
+    north = driving(0, -150, 90)       # northbound: it comes from the eastbound's right
+    lim = limits(east, north)
+    assert math.isinf(lim[1])
+    room = traffic.room(east, north)   # straight to north's route (its places 4 in apart)
+    assert room == pytest.approx(150 - traffic.zone(east, north) - traffic.SLACK, abs=0.1)
+    assert lim[0] == math.sqrt((40 * DT) ** 2 + 2 * 40 * room) - 40 * DT   # stops there
+    lim = limits(north, east)          # the same in the other order
+    assert math.isinf(lim[0]) and math.isfinite(lim[1])
+
+
+def test_head_on_and_one_behind_the_other_are_no_crossing():
+    assert traffic.crossing(driving(-150, 0, 0), driving(150, 10, 180)) is None
+    assert traffic.crossing(driving(-150, 0, 0), driving(-60, 0, 0)) is None
+    assert np.isinf(limits(driving(-150, 0, 0), driving(150, 10, 180))).all()
+
+
+def test_robots_far_apart_or_no_longer_driving_give_way_to_none():
+    assert np.isinf(limits(driving(-150, 0, 0), driving(0, -900, 90))).all()
+    assert np.isinf(limits(driving(-150, 0, 0), None)).all()
+
+
+def test_a_robot_that_can_no_longer_stop_short_of_the_crossing_goes_first():
+    # the eastbound robot has the northbound one on its right, but drives at 60 in/s 35 in
+    # before the crossing's edge: it cannot stop there (60^2 / 80 = 45 in, and a tick's 3)
+    fast = driving(-90, 0, 0, speed=60.0)
+    north = driving(0, -200, 90)
+    c = traffic.crossing(fast, north)
+    assert c is not None and c.right and traffic.committed(fast, c.enter[0], DT)
+    lim = limits(fast, north)
+    assert math.isinf(lim[0]) and math.isfinite(lim[1])
+
+
+def test_who_goes_first_is_kept_until_the_crossing_is_behind_them():
+    ways = traffic.Traffic()
+    east, north = driving(-150, 0, 0), driving(0, -150, 90)
+    assert math.isfinite(ways.limits([east, north], DT)[0]) and ways.order == {(0, 1): 1}
+    # the one giving way has nearly stopped and the other, slowed, is farther off: decided
+    # afresh, the eastbound robot would clear it first now; it waits on
+    east, north = driving(-80, 0, 0, speed=2.0), driving(0, -200, 90, speed=10.0)
+    assert math.isfinite(ways.limits([east, north], DT)[0]) and ways.order == {(0, 1): 1}
+    # the northbound robot is through, its rear past the crossing: the eastbound goes
+    east, north = driving(-80, 0, 0, speed=0.0), driving(0, 100, 90)
+    assert np.isinf(ways.limits([east, north], DT)).all() and ways.order == {}
+
+
+def test_four_robots_each_with_another_on_its_right_the_first_of_the_ring_goes():
+    ring = [driving(-150, -15, 0), driving(150, 15, 180), driving(-15, 150, 270),
+            driving(15, -150, 90)]
+    lim = limits(*ring)
+    assert math.isinf(lim[0])                         # the first in the world's order goes
+    assert np.isfinite(lim[1:]).all()                 # the others wait (on it, or in turn)
+
+
+def test_a_robot_already_in_the_crossing_giving_way_stops_where_it_is():
+    # the two routes moved (a replanning) and the robot giving way finds itself inside
+    ways = traffic.Traffic()
+    ways.order[0, 1] = 1
+    east, north = driving(-40, 0, 0, speed=20.0), driving(0, -150, 90)
+    c = traffic.crossing(east, north, known=True)
+    assert c is not None and traffic.room(east, north) == 0.0
+    assert ways.limits([east, north], DT)[0] == 0.0
+
+
+@settings(max_examples=200, deadline=None)
+@given(angle=st.floats(35, 145), da=st.floats(60, 220), db=st.floats(60, 220),
+       va=st.floats(0, 60), vb=st.floats(0, 60))
+def test_at_a_crossing_of_two_never_both_give_way_and_the_one_that_does_stops_outside(
+        angle, da, db, va, vb):
+    """Two straight routes crossing at the origin at ``angle``, the robots ``da`` and ``db``
+    in before it: at most one gives way, and its limit lets it stop before it comes within
+    the zone of the other's route (the room is measured straight to that route, never more
+    than along its own)."""
+    a = driving(-da, 0, 0, speed=va)
+    h = math.radians(angle)
+    b = driving(-db * math.cos(h), -db * math.sin(h), angle, speed=vb)
+    lim = limits(a, b)
+    assert np.isinf(lim).sum() >= 1
+    for i, (me, other) in enumerate(((a, b), (b, a))):
+        if not math.isinf(lim[i]):
+            room = traffic.room(me, other)
+            assert lim[i] == traffic.brake(room, me.acceleration, 0.0, DT)
+            gap = float(np.min(np.hypot(*(other.path - me.at).T)))
+            assert room <= max(gap - traffic.zone(me, other), 0.0)
+
+
+def _without_giving_way(world):
+    return dataclasses.replace(world, agents=tuple(
+        dataclasses.replace(a, robot=dataclasses.replace(a.robot, give_way=False))
+        for a in world.agents))
+
+
+def test_four_robots_at_a_crossroads_give_way_where_without_it_two_collide():
+    world = load_world(DATA / "crossroads4.yaml")
+    on = simulate(world, seed=1001, randomise=True)
+    off = simulate(_without_giving_way(world), seed=1001, randomise=True)
+    assert off.outcome == "collision" and off.robot_outcomes.count("collision") == 2
+    assert on.robot_outcomes == ("success",) * 4
+    assert on.metrics["min_clearance_in"] > 0
+
+
+def test_a_crossroads_run_gives_way_alike_alone_and_in_a_batch():
+    """Who goes first is each run's own state, kept from tick to tick: a run in a lockstep
+    batch gives way as it does alone (cut to 14 s: the robots are at the crossing)."""
+    from test_sim_lockstep import assert_same_run
+
+    world = load_world(DATA / "crossroads4.yaml").with_changes(time_limit=14.0)
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    seeds = [1001, 1003, 1011]
+    together = run_lockstep(world, planner, seeds, randomise=True, scene=scene)
+    for seed, res in zip(seeds, together):
+        alone = simulate(world, planner, seed, randomise=True, scene=scene)
+        assert_same_run(alone, res)
+        assert (res.speed[res.t > 10] < 1).any()          # somebody waited
+
+
+def test_a_robot_giving_way_longer_than_the_stuck_time_is_waiting_not_stuck(tmp_path):
+    """A slow robot (8 in/s) crossing from the right, near the crossing, keeps the other
+    waiting well over ``STUCK_TIME``; it then goes on and both arrive."""
+    text = (DATA / "crossroads4.yaml").read_text()
+    head = text[:text.index("robots:")]
+    world_file = tmp_path / "slow.yaml"
+    world_file.write_text(head.replace("q_init: {x: 30, y: -15, heading: 0}",
+                                       "q_init: {x: 250, y: -15, heading: 0}") + """robots:
+  - name: slow
+    robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, max_speed: 8}
+    q_init: {x: 415, y: -90, heading: 90}
+    q_goal: {x: 415, y: 370, tolerance: 12}
+
+map:
+  corridors:
+    - points: [[0, 0], [800, 0]]
+      width: 90
+    - points: [[400, -400], [400, 400]]
+      width: 90
+""")
+    res = simulate(load_world(world_file))
+    assert res.robot_outcomes == ("success", "success")
+    still = (res.speed[:, 0] < 0.5) & res.active[:, 0]
+    longest = max((len(run) for run in np.split(still, np.flatnonzero(~still)) if len(run)),
+                  default=0) * res.world.dt
+    assert longest > STUCK_TIME
+
+
+def test_give_way_is_a_robot_setting_of_the_world_file(tmp_path):
+    text = (DATA / "crossroads4.yaml").read_text()
+    off = tmp_path / "off.yaml"
+    off.write_text(text.replace("  acceleration: 40\n", "  acceleration: 40\n  give_way: false\n"))
+    assert not load_world(off).robot.give_way and load_world(DATA / "crossroads4.yaml").robot.give_way
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text.replace("  acceleration: 40\n", "  acceleration: 40\n  give_way: often\n"))
+    with pytest.raises(WorldError, match="give_way"):
+        load_world(bad)
