@@ -1625,6 +1625,8 @@ class Batch:
         self._starts = np.array([a for a, _ in self.spans])
         self._owner = [(run, i) for run in runs for i in range(run.n)]   # each row's robot
         self._single = len(self._owner) == len(runs)            # a robot a run (most worlds)
+        # the runs whose robots give way to each other (Simulation._give_way), with their rows
+        self._traffic = [(run, a, b) for run, (a, b) in zip(runs, self.spans) if run._traffic]
         # the runs' x, y, heading, speed and wheel as :meth:`move` left them (each run's
         # views of them), and the token it left on each run it moved
         self._moved: tuple[tuple[np.ndarray, ...], object] | None = None
@@ -1982,10 +1984,9 @@ class Batch:
         robot's run."""
         x, y, h = self._ticked()
         v, steer = self._drive
-        for run, (a, b) in zip(self.runs, self.spans):
-            if run._traffic:
-                run._give_way(self.command[a:b], self.active[a:b], x[a:b], y[a:b], v[a:b],
-                              self._hint[a:b])
+        for run, a, b in self._traffic:
+            run._give_way(self.command[a:b], self.active[a:b], x[a:b], y[a:b], v[a:b],
+                          self._hint[a:b])
         fleet = self._fleet
         rows = (self.active & fleet.brakes).nonzero()[0]
         if not len(rows):
