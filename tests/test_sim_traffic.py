@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from mitos_cli.errors import WorldError
 from mitos_cli.sim import traffic
 from mitos_cli.sim.lockstep import run_lockstep
-from mitos_cli.sim.loop import STUCK_TIME, prepare, simulate
+from mitos_cli.sim.loop import STUCK_TIME, Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.route import Route
 from mitos_cli.sim.world import Robot
@@ -193,3 +193,38 @@ def test_give_way_is_a_robot_setting_of_the_world_file(tmp_path):
     bad.write_text(text.replace("  acceleration: 40\n", "  acceleration: 40\n  give_way: often\n"))
     with pytest.raises(WorldError, match="give_way"):
         load_world(bad)
+
+
+def test_a_robot_told_to_stop_where_it_gives_way_is_waiting_not_stuck(tmp_path):
+    """A robot giving way (its limit 0, 12 in before the crossing) told to stop by its
+    planner, as DWA does for the robot it gives way to, waits as one the limit stops: the
+    slow robot from its right takes longer than ``STUCK_TIME`` to clear the crossing, and the
+    run goes on (the waiting was not counted where the command was no faster than the limit,
+    and the robot read ``stuck`` after 6 s)."""
+    text = (DATA / "crossroads4.yaml").read_text()
+    head = text[:text.index("robots:")]
+    world_file = tmp_path / "told.yaml"
+    world_file.write_text(head.replace("q_init: {x: 30, y: -15, heading: 0}",
+                                       "q_init: {x: 350, y: -15, heading: 0}") + """robots:
+  - name: slow
+    robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, max_speed: 8}
+    q_init: {x: 415, y: -90, heading: 90}
+    q_goal: {x: 415, y: 370, tolerance: 12}
+
+map:
+  corridors:
+    - points: [[0, 0], [800, 0]]
+      width: 90
+    - points: [[400, -400], [400, 400]]
+      width: 90
+""")
+    sim = Simulation(load_world(world_file), seed=1)
+    told = np.array([[90.0, 0.0], [90.0, 8.0]])         # the first stops, the slow drives on
+    while not sim._ways.order:                          # (the slow one's route 3 s ahead
+        sim.step(told)                                  # reaches the crossing at 2 s)
+    assert sim._ways.order == {(0, 1): 1} and sim.time < 3.0
+    for _ in range(int(round((STUCK_TIME + 3.0) / sim.dt))):
+        assert not sim.done, sim.result().robot_outcomes
+        sim.step(told)
+        assert sim._ways.order == {(0, 1): 1}           # the first gives way throughout
+    assert not sim.done

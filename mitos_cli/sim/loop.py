@@ -1348,7 +1348,11 @@ class Simulation:
         held = limit < command[:, 1]
         if held.any():
             command[held, 1] = limit[held]
-            self._gave_way_at[held] = self._k
+        # (waiting: held, or told no faster than the limit: a planner that stops for the
+        # robot it gives way to, at a limit of 0, waits as much as one the limit stops)
+        waiting = limit <= command[:, 1]
+        if waiting.any():
+            self._gave_way_at[waiting] = self._k
 
     def act(self, s: _Sensed) -> None:
         """Steering-rate and acceleration limits and exact arcs, substep by substep; stopped
