@@ -94,6 +94,22 @@ def test_four_robots_each_with_another_on_its_right_the_first_of_the_ring_goes()
     assert np.isfinite(lim[1:]).all()                 # the others wait (on it, or in turn)
 
 
+def test_rings_that_overlap_are_broken_so_that_each_pair_keeps_one_robot_waiting():
+    """Six robots at a crossroads (a helper's ``six.yaml``, seed 1005, at 17.25 s): rings
+    {1, 2, 5}, {2, 3, 5} and {3, 4, 5}. Dropping the waits of each ring's lowest robot freed
+    both robots of the pair (1, 2), which then collided."""
+    edges = {(1, 2), (2, 5), (5, 1), (2, 3), (3, 5), (3, 4), (4, 5), (0, 1)}
+    gives: list[dict[int, float]] = [{} for _ in range(6)]
+    for i, j in edges:
+        gives[i][j] = 1.0
+    traffic._unring(gives, lambda i, j: 2.0)
+    assert traffic._ring(gives) is None
+    after = {(i, j) for i in range(6) for j in gives[i]}
+    assert {frozenset(e) for e in after} == {frozenset(e) for e in edges}   # one each way
+    assert len(after) == len(edges)
+    assert gives[2][1] == 2.0 and 2 not in gives[1]     # the lowest goes, the other waits
+
+
 def test_a_robot_already_in_the_crossing_giving_way_stops_where_it_is():
     # the two routes moved (a replanning) and the robot giving way finds itself inside
     ways = traffic.Traffic()

@@ -33,8 +33,9 @@ batch. ``robot: {give_way: false}`` leaves a robot out (it neither shares nor gi
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -204,7 +205,7 @@ class Traffic:
         """Each robot's speed limit (in/s; ``inf`` where it gives way to none) among
         ``mates`` (``None``: a robot no longer driving or not sharing). Where giving way goes
         round in a ring (four robots at a crossroads, each with another on its right), the
-        first robot of the ring in the world's order goes."""
+        first robot of the ring in the world's order goes (:func:`_unring`)."""
         n = len(mates)
         gives: list[dict[int, float]] = [{} for _ in range(n)]
         for i in range(n):
@@ -220,15 +221,27 @@ class Traffic:
                     gives[j][i] = room(b, a)
                 else:
                     gives[i][j] = room(a, b)
-        while (ring := _ring(gives)) is not None:
-            lowest = min(ring)
-            gives[lowest] = {j: r for j, r in gives[lowest].items() if j not in ring}
+        _unring(gives, lambda i, j: room(cast(Mate, mates[i]), cast(Mate, mates[j])))
         out = np.full(n, np.inf)
         for i, given in enumerate(gives):
             m = mates[i]
             if m is not None and given:
                 out[i] = brake(min(given.values()), m.acceleration, 0.0, dt)
         return out
+
+
+def _unring(gives: list[dict[int, float]], room_of: Callable[[int, int], float]) -> None:
+    """Break every ring of giving way in ``gives`` (robot -> {robot it waits on: its room}):
+    the lowest robot of a ring goes, and the robots of the ring it waited on wait on it
+    instead (``room_of(i, j)``: ``i``'s room giving way to ``j``), so each pair that meets
+    still has one robot that waits. (Only dropping its waits freed, where rings overlap, both
+    robots of a pair: six robots at a crossroads met so.) Each turn makes an edge from a
+    lower robot to a higher one point down, so the turns end."""
+    while (ring := _ring(gives)) is not None:
+        lowest = min(ring)
+        for j in [j for j in gives[lowest] if j in ring]:
+            del gives[lowest][j]
+            gives[j][lowest] = room_of(j, lowest)
 
 
 def _ring(gives: list[dict[int, float]]) -> set[int] | None:
