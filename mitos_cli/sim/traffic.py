@@ -108,15 +108,6 @@ class Crossing:
     centre: tuple[float, float]
     right: bool                    # the second robot comes from the first's right
 
-    @property
-    def other(self) -> Crossing:
-        """The same crossing seen from the second robot."""
-        return Crossing(_swap(self.enter), _swap(self.leave), _swap(self.centre), not self.right)
-
-
-def _swap(pair: tuple[float, float]) -> tuple[float, float]:
-    return pair[1], pair[0]
-
 
 def crossing(a: Mate, b: Mate, known: bool = False) -> Crossing | None:
     """Where the routes of ``a`` and ``b`` cross ahead, or ``None``: apart, or, unless the
