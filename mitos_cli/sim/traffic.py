@@ -17,7 +17,8 @@ manager), and give way by the rule of the road:
   in it, is *committed* and goes first; of two committed, the one that comes first to where
   the routes meet; of none, the one coming from the other's right, unless the other clears
   the crossing :data:`CLEAR_BY` before it arrives. Four robots each with another on its right
-  wait on each other in a ring; the first of them in the world's order goes;
+  wait on each other in a ring; the first of them in the world's order goes, and those it
+  waited on wait on it;
 - **giving way** is a speed limit, :func:`.safety.brake`'s for the room left before the robot
   comes within the zone of the other's route and :data:`SLACK` more, measured straight to that
   route (never more than along its own, whatever a replanning does to either route); a robot
