@@ -1150,3 +1150,19 @@ def test_each_extras_hint_names_what_pyproject_installs_for_it() -> None:
         assert install_hint(extra).startswith("pip install ") and "mitos[" not in install_hint(extra)
     assert install_hint("plot") == "pip install 'matplotlib>=3.6' (the `plot` extra of mitos-planner)"
 
+
+@pytest.mark.parametrize("char", ["\x0b", "\x0c", "\x1c", "\x85", "\u2028", "\u2029"])
+def test_the_line_shown_is_the_one_named_past_a_character_splitlines_breaks_at(char):
+    """Lark counts lines at `\\n`; the line under a message was found with `str.splitlines`,
+    which also breaks at a form feed or U+2028 in a comment: `r2`'s error was shown under
+    `r1`'s line, its caret under `is WIDE` there."""
+    from mitos_cli.lang.parse import parse_rules
+
+    text = (f'# a comment {char} of two parts\nterms "mitos.terms.yaml"\nbehavior b:\n'
+            "  r1: if road is WIDE then steering is RS\n"
+            "  r2: if road isWIDE then steering is RS\nend\n")
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_rules(text, "x.rules")
+    span = info.value.span
+    assert (span.line, span.column) == (5, 15)
+    assert span.source_line == "  r2: if road isWIDE then steering is RS"
