@@ -132,6 +132,17 @@ def _lines(text: str) -> tuple[str, ...]:
 _BREAK = re.compile(r"\r\n|\r|\n")
 
 
+_LONE_CR = re.compile(r"\r(?!\n)")
+
+
+def lone_cr_as_lf(text: str) -> str:
+    """``text`` with each ``\r`` that ends a line alone (classic Mac OS files) as ``\n``, for
+    a lexer that counts lines at ``\n`` (Lark): it read such a file as one line, so a ``#``
+    or ``//`` comment on the first line took every line after it (a rule file "names no term
+    set", an FCL file ended early) and every message was at line 1. Offsets stay as they were."""
+    return _LONE_CR.sub("\n", text) if "\r" in text else text
+
+
 def lines_of(text: str) -> list[str]:
     """The lines of ``text`` as an editor and the readers' lexers count them, at ``\n``,
     ``\r\n`` and ``\r``. ``str.splitlines`` also breaks at a vertical tab, a form feed,

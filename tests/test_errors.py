@@ -1166,3 +1166,21 @@ def test_the_line_shown_is_the_one_named_past_a_character_splitlines_breaks_at(c
     span = info.value.span
     assert (span.line, span.column) == (5, 15)
     assert span.source_line == "  r2: if road isWIDE then steering is RS"
+
+
+def test_a_rule_file_with_lone_cr_line_ends_reads_as_with_lf():
+    """A file from classic Mac OS ends its lines with `\\r` alone: Lark counts lines at `\\n`,
+    so the first line's comment ran to the end of the file ("the rule file names no term
+    set", at 1:1), and a mistake was named at line 1, column 500."""
+    from mitos_cli.lang.parse import parse_rules
+
+    text = (Path(__file__).parent.parent / "rulebases" / "mitos.rules").read_text()
+    cr = parse_rules(text.replace("\n", "\r"), "x.rules")
+    lf = parse_rules(text, "x.rules")
+    assert cr.behaviors == lf.behaviors and len(cr.behaviors[0].rules) == 27
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_rules(text.replace("r4: if road is WIDE", "r4: if road isWIDE").replace("\n", "\r"),
+                    "cr.rules")
+    span = info.value.span
+    assert (span.line, span.column) == (24, 17)
+    assert span.source_line.strip().startswith("r4: if road isWIDE")

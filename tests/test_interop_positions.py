@@ -176,3 +176,18 @@ def test_a_line_is_the_editors_line_past_a_character_splitlines_breaks_at(
     line = next(i for i, x in enumerate(bad.split("\n"), 1) if new in x)
     assert span is not None and span.line == line, info.value.render()
     assert span.source_line is not None and new in span.source_line, info.value.render()
+
+
+def test_an_fcl_file_with_lone_cr_line_ends_reads_as_with_lf() -> None:
+    """jFuzzyLogic ends a `//` comment at `\\r` too: the first line's comment took the whole of
+    a classic Mac OS file ("unexpected end of file" at line 1), and a mistake was named at
+    line 1."""
+    cr = parse_fcl(FCL.replace("\n", "\r"), "x.fcl")
+    lf = parse_fcl(FCL, "x.fcl")
+    assert cr.behaviors == lf.behaviors and len(cr.behaviors[0].rules) == 4
+    bad = FCL.replace("IF service IS good", "IF service ISgood").replace("\n", "\r")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(bad, "cr.fcl")
+    span = info.value.span
+    assert span is not None and span.line == line_of(FCL, "IF service IS good")
+    assert span.source_line is not None and "ISgood" in span.source_line

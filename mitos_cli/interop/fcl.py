@@ -45,7 +45,14 @@ import numpy as np
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import FormatError, NoRulesError, Span, did_you_mean, lines_of
+from ..errors import (
+    FormatError,
+    NoRulesError,
+    Span,
+    did_you_mean,
+    lines_of,
+    lone_cr_as_lf,
+)
 from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
@@ -227,6 +234,7 @@ def _expected(terminals: set[str]) -> str | None:
 @without_cyclic_gc
 def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     """Read FCL ``text`` into a rule base (one behavior, ``main``)."""
+    text = lone_cr_as_lf(text)
     tree = _parse(text, path)
 
     def span_of(node: Node) -> Span:

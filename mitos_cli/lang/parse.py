@@ -24,7 +24,7 @@ from lark.exceptions import (
     VisitError,
 )
 
-from ..errors import MitosError, RuleSyntaxError, Span, did_you_mean, lines_of
+from ..errors import MitosError, RuleSyntaxError, Span, did_you_mean, lines_of, lone_cr_as_lf
 from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
@@ -952,6 +952,7 @@ def check_rule_file_size(text: str, path: str | None) -> None:
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
     check_rule_file_size(text, path)
+    text = lone_cr_as_lf(text)
     tree = parse_tree(text, path)
     items = _ToModel(text, path).transform(tree).children
     terms: list[tuple[str, Span]] = []
