@@ -1184,3 +1184,20 @@ def test_a_rule_file_with_lone_cr_line_ends_reads_as_with_lf():
     span = info.value.span
     assert (span.line, span.column) == (24, 17)
     assert span.source_line.strip().startswith("r4: if road isWIDE")
+
+
+def test_is_glued_to_a_term_is_said_in_linear_time_after_a_long_word():
+    """The name before a glued `isWIDE` was found with a regex search from the file's start,
+    which tried every start in every word: a 40,000-letter word in a comment took 10 s."""
+    import time
+
+    from mitos_cli.lang.parse import parse_rules
+
+    text = ("# " + "x" * 40_000 + ".\nterms \"mitos.terms.yaml\"\nbehavior b:\n"
+            "  r1: if road isWIDE then steering is RS\nend\n")
+    t0 = time.process_time()
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_rules(text, "x.rules")
+    assert time.process_time() - t0 < 2
+    assert (info.value.span.line, info.value.span.column) == (4, 15)
+    assert info.value.hint == "`is` and `WIDE` are two words: `road is WIDE`"
