@@ -124,9 +124,33 @@ def _whole_word(token: str) -> re.Pattern[str]:
 
 @functools.lru_cache(maxsize=2)
 def _lines(text: str) -> tuple[str, ...]:
-    """``text.splitlines()``, kept for the last texts (a str caches its hash, and a cache hit
+    """``lines_of(text)``, kept for the last texts (a str caches its hash, and a cache hit
     on the same object compares by identity: after the first call, O(1))."""
-    return tuple(text.splitlines())
+    return tuple(lines_of(text))
+
+
+_BREAK = re.compile(r"\r\n|\r|\n")
+
+
+_LONE_CR = re.compile(r"\r(?!\n)")
+
+
+def lone_cr_as_lf(text: str) -> str:
+    """``text`` with each ``\r`` that ends a line alone (classic Mac OS files) as ``\n``, for
+    a lexer that counts lines at ``\n`` (Lark): it read such a file as one line, so a ``#``
+    or ``//`` comment on the first line took every line after it (a rule file "names no term
+    set", an FCL file ended early) and every message was at line 1. Offsets stay as they were."""
+    return _LONE_CR.sub("\n", text) if "\r" in text else text
+
+
+def lines_of(text: str) -> list[str]:
+    """The lines of ``text`` as an editor and the readers' lexers count them, at ``\n``,
+    ``\r\n`` and ``\r``. ``str.splitlines`` also breaks at a vertical tab, a form feed,
+    U+001C to U+001E, U+0085, U+2028 and U+2029 inside a line, so a message about a later
+    line showed the line before it (a rule file with U+2028 in a comment: `r2`'s error, under
+    `r1`'s line) and the FLL and ``.fis`` readers numbered every later line one too far on."""
+    lines = _BREAK.split(text)
+    return lines[:-1] if lines[-1:] == [""] else lines
 
 
 #: how much of a long source line a span keeps (characters, around the column)

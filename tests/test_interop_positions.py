@@ -148,3 +148,46 @@ def test_a_hedge_fuzzylite_lacks_is_refused_where_the_rule_uses_it(tmp_path, fmt
             as info:
         write_foreign(read_rulebase(path), fmt)
     assert str(info.value.span) == f"{path}:3:{column}"
+
+
+#: characters ``str.splitlines`` breaks a line at, which no editor or reader's lexer does
+NOT_BREAKS = ["\x0b", "\x0c", "\x1c", "\x85", "\u2028", "\u2029"]
+
+
+@pytest.mark.parametrize("char", NOT_BREAKS)
+@pytest.mark.parametrize("parse, text, inside, old, new", [
+    (parse_fll, FLL, "Engine: test # a", "term: low Triangle 0 2 5", "term low Triangle 0 2 5"),
+    (parse_fis, FIS, "[System]\n% a", "Version=2.0", "Versoin=2.0"),
+    (parse_fcl, FCL, "// Block definition", "RULE 2 : IF service IS good",
+     "RULE 2 : IF service ISgood"),
+])
+def test_a_line_is_the_editors_line_past_a_character_splitlines_breaks_at(
+        char, parse, text, inside, old, new) -> None:
+    """A vertical tab, form feed, U+0085 or U+2028 in a line (a comment, a description) put
+    every later message a line off: the FLL and ``.fis`` readers numbered lines with
+    ``str.splitlines`` (the line after the mistake named), and the caret of FCL's showed the
+    line before the one Lark named."""
+    where = inside.split("\n")[0].split(" #")[0]     # what ``inside`` adds to
+    assert where in text
+    bad = text.replace(where, inside + " " + char + " b", 1).replace(old, new, 1)
+    with pytest.raises(MitosError) as info:
+        parse(bad, "bad")
+    span = info.value.span
+    line = next(i for i, x in enumerate(bad.split("\n"), 1) if new in x)
+    assert span is not None and span.line == line, info.value.render()
+    assert span.source_line is not None and new in span.source_line, info.value.render()
+
+
+def test_an_fcl_file_with_lone_cr_line_ends_reads_as_with_lf() -> None:
+    """jFuzzyLogic ends a `//` comment at `\\r` too: the first line's comment took the whole of
+    a classic Mac OS file ("unexpected end of file" at line 1), and a mistake was named at
+    line 1."""
+    cr = parse_fcl(FCL.replace("\n", "\r"), "x.fcl")
+    lf = parse_fcl(FCL, "x.fcl")
+    assert cr.behaviors == lf.behaviors and len(cr.behaviors[0].rules) == 4
+    bad = FCL.replace("IF service IS good", "IF service ISgood").replace("\n", "\r")
+    with pytest.raises(MitosError) as info:
+        parse_fcl(bad, "cr.fcl")
+    span = info.value.span
+    assert span is not None and span.line == line_of(FCL, "IF service IS good")
+    assert span.source_line is not None and "ISgood" in span.source_line

@@ -452,7 +452,18 @@ def test_one_run_shows_no_spread():
 def test_a_nan_option_is_a_usage_error(short, option):
     res = run(short, *option)
     said = " ".join(res.output.replace("│", " ").split())
-    assert res.exit_code == 2 and "must be a number" in said and "not `nan`" in said
+    assert res.exit_code == 2 and "must be" in said and "not `nan`" in said
+
+
+@pytest.mark.parametrize("given", ["4.9e-324", "1e-310", "1e-400", "0.0009", "-1", "abc"])
+def test_a_speed_too_slow_to_pace_is_a_usage_error(short, given):
+    """`--speed 4.9e-324` waited 1e323 seconds for its first tick: past what `time.sleep`
+    takes, a traceback (and `1e-9` thirty years per simulated second)."""
+    res = run(short, "--speed", given)
+    said = " ".join(res.output.replace("│", " ").split())
+    assert res.exit_code == 2, res.output
+    assert ("the real-time factor must be 0 (as fast as it can) or a number of 0.001 or more, "
+            f"not `{given}`") in said
 
 
 def test_an_empty_behavior_is_a_usage_error(short):

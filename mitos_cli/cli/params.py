@@ -85,13 +85,7 @@ class Number(FloatRange):
             kind += f" of {exact(self.min)} or more"
         elif self.max is not None:
             kind += f" of {exact(self.max)} or less"
-        if not text.strip():
-            given = "an empty value"
-        elif len(text) > 60:
-            given = f"`{visible(text[:20])}...{visible(text[-10:])}` ({len(text):,} characters)"
-        else:
-            given = f"`{visible(text)}`"
-        return f"{self.what} must be {kind}, not {given}{self.how(text)}"
+        return f"{self.what} must be {kind}, not {given(text)}{self.how(text)}"
 
     def how(self, text: str) -> str:
         """How to write ``text`` as a number this option takes, where that can be told."""
@@ -111,6 +105,36 @@ class Number(FloatRange):
         if self.whole and _WHOLE.fullmatch(text) and 0 < most < len(text.strip().lstrip("+-")):
             return f": Python reads whole numbers of at most {most:,} digits"
         return ""
+
+
+class Factor(Number):
+    """A factor that is 0 or at least ``least`` (``simulate --speed``): a run paced to a
+    factor of ``4.9e-324`` waited ``t / 4.9e-324`` seconds for its first tick, past what
+    ``time.sleep`` takes (a traceback, "timestamp out of range for platform time_t"), and
+    ``1e-9`` thirty years a second of the run. Below ``least``, a usage error that says so."""
+
+    def __init__(self, what: str, least: float, zero: str) -> None:
+        super().__init__(what, 0.0, whole=False)
+        self.least, self.zero = least, zero
+
+    def read(self, text: str) -> int | float | None:
+        x = super().read(text)
+        if x == 0 and re.search(r"[1-9]", text.lower().split("e")[0]):
+            return None                 # `1e-400`: a factor too small for a float, not 0
+        return None if x is not None and 0 < x < self.least else x
+
+    def wrong(self, text: str) -> str:
+        return (f"{self.what} must be 0 ({self.zero}) or a number of {exact(self.least)} or "
+                f"more, not {given(text)}{self.how(text)}")
+
+
+def given(text: str) -> str:
+    """An option's value as a message quotes it (a long one abridged)."""
+    if not text.strip():
+        return "an empty value"
+    if len(text) > 60:
+        return f"`{visible(text[:20])}...{visible(text[-10:])}` ({len(text):,} characters)"
+    return f"`{visible(text)}`"
 
 
 #: a whole number as an option takes it: ASCII digits, a sign, spaces around

@@ -11,7 +11,7 @@ import typer
 from ..words import clearance, percent, plural
 from . import complete
 from .output import emit, err, json_text, warn
-from .params import MAX_RUNS, WORDS, Number, file_arg, named, option_names
+from .params import MAX_RUNS, WORDS, Factor, Number, file_arg, named, option_names
 from .progress import INTERRUPTED, progress_bar
 from .targets import check_directory, check_suffix
 
@@ -240,7 +240,7 @@ def simulate_command(
     live: Annotated[bool, typer.Option(
         "--live", help="Show a terminal view on stderr while it runs, paced by --speed.")] = False,
     speed: Annotated[Optional[float], typer.Option(
-        "--speed", metavar="X", click_type=Number("the real-time factor", 0.0, whole=False),
+        "--speed", metavar="X", click_type=Factor("the real-time factor", 0.001, "as fast as it can"),
         help="Real-time factor of --live (implies it): 1 real time (the default), 4 four "
              "times faster, 0 as fast as it can.")] = None,
     animate: Annotated[Optional[Path], typer.Option(

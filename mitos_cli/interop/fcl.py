@@ -45,7 +45,14 @@ import numpy as np
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import FormatError, NoRulesError, Span, did_you_mean
+from ..errors import (
+    FormatError,
+    NoRulesError,
+    Span,
+    did_you_mean,
+    lines_of,
+    lone_cr_as_lf,
+)
 from ..fuzzy import norms
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
@@ -105,7 +112,7 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
     expected = set(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ())
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
-        lines = text.splitlines() or [""]
+        lines = lines_of(text) or [""]
         line, column = len(lines), len(lines[-1]) + 1
         what = "unexpected end of file"
     elif isinstance(exc, UnexpectedToken):
@@ -227,6 +234,7 @@ def _expected(terminals: set[str]) -> str | None:
 @without_cyclic_gc
 def parse_fcl(text: str, path: str | None = None) -> RuleBase:
     """Read FCL ``text`` into a rule base (one behavior, ``main``)."""
+    text = lone_cr_as_lf(text)
     tree = _parse(text, path)
 
     def span_of(node: Node) -> Span:

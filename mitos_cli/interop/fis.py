@@ -35,7 +35,7 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from ..errors import FormatError, Span, did_you_mean
+from ..errors import FormatError, Span, did_you_mean, lines_of
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
 from ..lang.model import And, Consequent, Or, Prop, Rule, RuleBase, Setting
@@ -99,7 +99,7 @@ def _sections(text: str, path: str | None) -> tuple[list[Section], list[tuple[st
     """``[(name, span, [(key, value, span, vspan), ...]), ...]`` and the rule lines."""
     sections: list = []
     rules: list = []
-    for lineno, raw in enumerate(text.splitlines(), 1):
+    for lineno, raw in enumerate(lines_of(text), 1):
         line = raw.strip()
         if not line or line[0] in "%#":         # MATLAB's readfis skips % and # comment lines
             continue

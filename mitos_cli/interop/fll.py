@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput, UnexpectedToken
 
-from ..errors import FormatError, Span, did_you_mean
+from ..errors import FormatError, Span, did_you_mean, lines_of
 from ..fuzzy.formula import parse as parse_formula
 from ..fuzzy.shapes import TSUKAMOTO
 from ..lang.bulk import without_cyclic_gc
@@ -198,7 +198,7 @@ def _sections(text: str, path: str | None) -> tuple[list[_Var], list[_Block], Sp
     current: _Var | None = None
     engine_span = Span.in_text(text, path, 1, 1)
 
-    for lineno, raw in enumerate(text.splitlines(), 1):
+    for lineno, raw in enumerate(lines_of(text), 1):
         line = raw.split("#", 1)[0].rstrip()
         if not line.strip():
             continue

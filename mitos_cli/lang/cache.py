@@ -47,13 +47,14 @@ from .model import RuleBase
 if TYPE_CHECKING:
     from lark import Lark
 
-_FORMAT = 9                  # raised when parsing changes (3: `very not` refused, `main` placed;
+_FORMAT = 10                 # raised when parsing changes (3: `very not` refused, `main` placed;
                              # 4: a formula's operators of one precedence are one node, a
                              # file-level operator set again is noted; 5: a control character
                              # in a name, description or unit refused; 6: a line break in a
                              # name or unit refused; 7: a bidirectional override refused too;
                              # 8: a format character in a name refused; 9: a keyword glued to
-                             # the next word refused, `r1: ifroad is ...`)
+                             # the next word refused, `r1: ifroad is ...`; 10: lines at
+                             # `\r` alone, not at U+2028 or a form feed)
 _TAG = 32                    # bytes of HMAC-SHA256 before every entry
 _KEY = "key"
 

@@ -24,7 +24,7 @@ from lark.exceptions import (
     VisitError,
 )
 
-from ..errors import MitosError, RuleSyntaxError, Span, did_you_mean
+from ..errors import MitosError, RuleSyntaxError, Span, did_you_mean, lines_of, lone_cr_as_lf
 from ..fuzzy.hedges import HEDGES
 from ..resources import grammar_text
 from .bulk import without_cyclic_gc
@@ -148,7 +148,7 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
             return stray
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
-        lines = text.rstrip().splitlines() or [""]
+        lines = lines_of(text.rstrip()) or [""]
         line = len(lines)
         column = len(lines[-1]) + 1
         names = getattr(exc, "expected", None) or []
@@ -223,7 +223,7 @@ def _operators_cut_short(text: str, path: str | None, line: int | None
     max``) goes on with a setting, not a statement, and is not this."""
     if line is None:
         return None
-    lines = text.splitlines()
+    lines = lines_of(text)
     for i in range(min(line, len(lines)) - 2, max(line - 5, -1), -1):
         code = lines[i].split("#", 1)[0].rstrip()
         if not re.match(r"[ \t]*operators[ \t]*:", code) or not code.endswith(("=", ",")):
@@ -249,7 +249,7 @@ def _missing_colon(exc: UnexpectedToken, text: str, path: str | None) -> RuleSyn
     if set(exc.expected) != {"COLON"} or last is None or last.end_line is None \
             or last.end_line >= exc.token.line:
         return None
-    line = text.splitlines()[last.end_line - 1]
+    line = lines_of(text)[last.end_line - 1]
     return RuleSyntaxError(f"missing `:` after `{line[:last.end_column - 1].strip()}`",
                            span=Span.in_text(text, path, last.end_line, last.end_column,
                                              last.end_column + 1),
@@ -479,7 +479,7 @@ def glued_name_hint(text: str, token: Token) -> str | None:
     glued to the word after a term (``road is WIDE andsize is ...``, ``steering is RS andspeed
     is ...``): one name to the lexer, and the error said only what was expected there (or,
     for ``andspeed is``, that ``andspeed`` was a new rule's label without its ``:``)."""
-    lines = text.splitlines()
+    lines = lines_of(text)
     if token.type == "$END" or token.line is None or token.column is None \
             or token.line > len(lines):
         return None
@@ -506,7 +506,7 @@ def glued_name_hint(text: str, token: Token) -> str | None:
 
 def _word_before(text: str, token: Token) -> str:
     """The word just before ``token`` on its line (for hints)."""
-    lines = text.splitlines()
+    lines = lines_of(text)
     if token.line is None or token.column is None or not 0 < token.line <= len(lines):
         return ""
     words = lines[token.line - 1][:token.column - 1].split()
@@ -739,9 +739,8 @@ def glued_error(glued: Glued, text: str, path: str | None, parser: Lark, start: 
     typo = str(second).isalpha() and (len(str(second)) == 1 or
                                       set(str(second).lower()) == {str(first)[-1:].lower()})
     if first.type == "IS" and glued.fits:
-        var = re.search(r"([A-Za-z_][\w\-]*)\s*$", text[:start_pos])
-        return _glued_is_error(text, path, var.group(1) if var else "x", start_pos, end_pos,
-                               None if typo else str(second))
+        return _glued_is_error(text, path, _name_before(text, start_pos) or "x", start_pos,
+                               end_pos, None if typo else str(second))
     expected = accepted_before(parser, text, first, start)
     keywords = [e.lower() for e in expected if e.isupper() and e.isalpha() and e != "NAME"]
     said = next((k for k in keywords if word.startswith(k) and len(word) > len(k)), None)
@@ -759,6 +758,21 @@ def glued_error(glued: Glued, text: str, path: str | None, parser: Lark, start: 
                            span=Span.in_text(text, path, line, column, column + len(word)
                                              if "\n" not in word else None),
                            expected=(words or _expected)(expected), hint=hint)
+
+
+def _name_before(text: str, end: int) -> str | None:
+    r"""The name that ends ``text[:end]``, blanks after it aside (``road`` of ``if road
+    isWIDE``), found from the end: ``re.search(r"([A-Za-z_][\w\-]*)\s*$", text[:end])`` tried
+    every start in every word of the file, so a 20,000-letter word in a comment took 2.6 s to
+    say ``isWIDE`` (40,000: 10 s)."""
+    before = text[:end].rstrip()
+    i = len(before)
+    while i and (before[i - 1].isalnum() or before[i - 1] in "_-"):
+        i -= 1
+    word = before[i:]
+    first = next((k for k, c in enumerate(word) if c == "_" or c.isascii() and c.isalpha()),
+                 None)
+    return word[first:] if first is not None else None
 
 
 def keyword_glued(first: Token, second: Token, parser: Lark) -> bool:
@@ -952,6 +966,7 @@ def check_rule_file_size(text: str, path: str | None) -> None:
 def parse_rules(text: str, path: str | None = None) -> ParsedFile:
     """Parse a whole rule file into model objects (names unchecked)."""
     check_rule_file_size(text, path)
+    text = lone_cr_as_lf(text)
     tree = parse_tree(text, path)
     items = _ToModel(text, path).transform(tree).children
     terms: list[tuple[str, Span]] = []

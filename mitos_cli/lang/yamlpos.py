@@ -257,10 +257,11 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
 
 
 #: a key glued to its value (`seed:3`, `- radius:9`): YAML reads `seed:3` as one plain word
-_GLUED_KEY = re.compile(r"^[ \t]*(?:-[ \t]+)?([A-Za-z_][\w.-]*):([^\s:/\\#'\"][^#]*?)[ \t]*"
-                        r"(?:#.*)?$")
+#: (matched on the line without its comment and trailing blanks: a lazy value before
+#: `[ \t]*(?:#.*)?$` tried every end, quadratic in a line of blanks)
+_GLUED_KEY = re.compile(r"[ \t]*(?:-[ \t]+)?([A-Za-z_][\w.-]*):([^\s:/\\#'\"].*)")
 #: a list item's `-` glued to the item (`-points:`, `-{name: A}`): YAML reads a plain word
-_GLUED_DASH = re.compile(r"^[ \t]*-([\[{A-Za-z_][^#]*?)[ \t]*(?:#.*)?$")
+_GLUED_DASH = re.compile(r"[ \t]*-([\[{A-Za-z_].*)")
 
 
 def glued_hint(text: str, line: int) -> str | None:
@@ -269,12 +270,13 @@ def glued_hint(text: str, line: int) -> str | None:
     was due, or a line later) or a list's `-` to its item (``-points:``)."""
     lines = text.splitlines()
     for i in range(min(line, len(lines)) - 1, max(line - 4, -1), -1):
-        key = _GLUED_KEY.match(lines[i])
+        code = lines[i].split("#", 1)[0].rstrip(" \t")
+        key = _GLUED_KEY.fullmatch(code)
         if key:
             value = key.group(2) if len(key.group(2)) <= 24 else key.group(2).split()[0]
             return (f"`{key.group(1)}:{value}` (line {i + 1}) is one word to YAML: a key's "
                     f"`:` needs a space after it, `{key.group(1)}: {value}`")
-        dash = _GLUED_DASH.match(lines[i])
+        dash = _GLUED_DASH.fullmatch(code)
         if dash:
             word = dash.group(1).split()[0]
             return (f"`-{word}` (line {i + 1}) is one word to YAML: a list item's `-` needs a "

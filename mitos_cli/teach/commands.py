@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from lark import Lark, Token, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..errors import LessonError, RuleSyntaxError, Span
+from ..errors import LessonError, RuleSyntaxError, Span, lines_of
 from ..lang.cache import lark_parser
 from ..lang.lexing import Glued, parse_apart
 from ..lang.model import Rule, Setting, Use
@@ -651,7 +651,7 @@ FIRST_WORDS_HINT = ("a line is a rule (`if ... then ...`) or a command: " + ", "
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError:
     """Lark's exception in words: never ``$END`` or ``Token(...)``."""
-    lines = text.splitlines() or [""]
+    lines = lines_of(text) or [""]
     if isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
@@ -663,7 +663,7 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     expected = set(getattr(exc, "expected", None) or ())
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
-        line = len(text.rstrip().splitlines()) or 1
+        line = len(lines_of(text.rstrip())) or 1
         column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
         if text.split()[:1] == ["at"] and "to" in text.split()[2:3]:   # LALR's merged states:
             expected = {e for e in expected if e.upper() != "TO"}     # the `to` is behind us

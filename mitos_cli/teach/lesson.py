@@ -8,11 +8,18 @@ reproducible and testable (``mitos teach ... --lesson FILE`` exits 1).
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import LessonError, MitosError, RuleSyntaxError, Span, WorldError, visible
+from ..errors import (
+    LessonError,
+    MitosError,
+    RuleSyntaxError,
+    Span,
+    WorldError,
+    lines_of,
+    visible,
+)
 from ..lang.parse import MAX_RULE_FILE_CHARS
 from ..resources import exists
 from .commands import incomplete
@@ -130,13 +137,6 @@ def not_a_lesson(path: str) -> str | None:
                 f"evaluates its rows; a lesson gives examples with `correct NAME=VALUE ... -> "
                 f"OUTPUT=VALUE`")
     return None
-
-
-def lines_of(text: str) -> list[str]:
-    """The lines of a lesson as an editor counts them: ``str.splitlines`` also breaks at a form
-    feed, U+2028 or U+0085 inside a line, so every line after one was named one too far on."""
-    lines = re.split(r"\r\n|\r|\n", text)
-    return lines[:-1] if lines[-1:] == [""] else lines
 
 
 def lesson_end(text: str, path: str) -> Span:
