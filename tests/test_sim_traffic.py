@@ -172,14 +172,14 @@ def test_a_crossroads_run_gives_way_alike_alone_and_in_a_batch():
         assert (res.speed[res.t > 10] < 1).any()          # somebody waited
 
 
-def test_a_robot_giving_way_longer_than_the_stuck_time_is_waiting_not_stuck(tmp_path):
-    """A slow robot (8 in/s) crossing from the right, near the crossing, keeps the other
-    waiting well over ``STUCK_TIME``; it then goes on and both arrive."""
+def _slow_from_the_right(tmp_path: Path, x: float) -> Path:
+    """crossroads4's map with two robots: one eastbound from (``x``, -15), and a slow one
+    (8 in/s) northbound 90 in below the crossing, coming from its right."""
     text = (DATA / "crossroads4.yaml").read_text()
-    head = text[:text.index("robots:")]
-    world_file = tmp_path / "slow.yaml"
-    world_file.write_text(head.replace("q_init: {x: 30, y: -15, heading: 0}",
-                                       "q_init: {x: 250, y: -15, heading: 0}") + """robots:
+    head = text[:text.index("robots:")].replace("q_init: {x: 30, y: -15, heading: 0}",
+                                                f"q_init: {{x: {x:g}, y: -15, heading: 0}}")
+    path = tmp_path / f"slow{x:g}.yaml"
+    path.write_text(head + """robots:
   - name: slow
     robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, max_speed: 8}
     q_init: {x: 415, y: -90, heading: 90}
@@ -192,7 +192,13 @@ map:
     - points: [[400, -400], [400, 400]]
       width: 90
 """)
-    res = simulate(load_world(world_file))
+    return path
+
+
+def test_a_robot_giving_way_longer_than_the_stuck_time_is_waiting_not_stuck(tmp_path):
+    """A slow robot (8 in/s) crossing from the right, near the crossing, keeps the other
+    waiting well over ``STUCK_TIME``; it then goes on and both arrive."""
+    res = simulate(load_world(_slow_from_the_right(tmp_path, 250)))
     assert res.robot_outcomes == ("success", "success")
     still = (res.speed[:, 0] < 0.5) & res.active[:, 0]
     longest = max((len(run) for run in np.split(still, np.flatnonzero(~still)) if len(run)),
@@ -217,24 +223,7 @@ def test_a_robot_told_to_stop_where_it_gives_way_is_waiting_not_stuck(tmp_path):
     slow robot from its right takes longer than ``STUCK_TIME`` to clear the crossing, and the
     run goes on (the waiting was not counted where the command was no faster than the limit,
     and the robot read ``stuck`` after 6 s)."""
-    text = (DATA / "crossroads4.yaml").read_text()
-    head = text[:text.index("robots:")]
-    world_file = tmp_path / "told.yaml"
-    world_file.write_text(head.replace("q_init: {x: 30, y: -15, heading: 0}",
-                                       "q_init: {x: 350, y: -15, heading: 0}") + """robots:
-  - name: slow
-    robot: {model: tricycle, wheelbase: 16, footprint: {length: 24, width: 18}, max_speed: 8}
-    q_init: {x: 415, y: -90, heading: 90}
-    q_goal: {x: 415, y: 370, tolerance: 12}
-
-map:
-  corridors:
-    - points: [[0, 0], [800, 0]]
-      width: 90
-    - points: [[400, -400], [400, 400]]
-      width: 90
-""")
-    sim = Simulation(load_world(world_file), seed=1)
+    sim = Simulation(load_world(_slow_from_the_right(tmp_path, 350)), seed=1)
     told = np.array([[90.0, 0.0], [90.0, 8.0]])         # the first stops, the slow drives on
     while not sim._ways.order:                          # (the slow one's route 3 s ahead
         sim.step(told)                                  # reaches the crossing at 2 s)
