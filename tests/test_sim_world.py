@@ -588,9 +588,12 @@ def test_a_goal_the_body_cannot_reach_within_its_tolerance_is_refused():
     assert parse_world(gap + box % ", velocity: [0, 30]", "w.yaml")     # a cart drives off
 
 
-def test_an_empty_number_says_so():
-    msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
-    assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg
+@pytest.mark.parametrize("written, said", [("~", "`~`"), ("null", "`null`"),
+                                           ("", "nothing (an empty value)")])
+def test_an_empty_number_says_so(written, said):
+    """Nothing is quoted as written: `null` read "nothing (an empty value or `~`)"."""
+    msg = error(BASE.replace("time_limit: 10", f"time_limit: {written}"))
+    assert "w.yaml:4:" in msg and f"must be a number, not {said}\n" in msg, msg
 
 
 def test_a_name_with_a_control_character_is_refused():

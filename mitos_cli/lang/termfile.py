@@ -318,7 +318,8 @@ def _flag(spec: YMap, key: str, default: bool, what: str, hint: str) -> bool:
     """A yes/no key of a term: YAML's `true`/`false` only, since `"no"` would be truthy."""
     value = spec.get(key, default)
     if not isinstance(value, bool):
-        raise TermSetError(f"{what}: `{key}` must be true or false, not `{value}`",
+        raise TermSetError(f"{what}: `{key}` must be true or false, not "
+                           f"{yamlpos.as_written(value, spec.value_span(key))}",
                            span=spec.value_span(key), hint=hint)
     return value
 

@@ -61,6 +61,9 @@ MODES = ("loop", "ping-pong", "stop")
 #: keys whose value is a thing of that name ("unknown shape `circel`" reads); for the others
 #: ("unknown unknown `ocupied`" does not) an error quotes `key: value`
 NOUN_KEYS = ("model", "layout", "shape", "mode")
+#: a world's keys that hold for all its robots (written under a robot, they are misplaced)
+SHARED_KEYS = tuple(k for k in TOP_KEYS if k not in ("name", "robot", "q_init", "q_goal",
+                                                     "robots"))
 
 
 #: The largest magnitude of any number in a world (inches, seconds, degrees): 1e7 in is
@@ -103,8 +106,15 @@ class _Reader:
     def __init__(self, path: str) -> None:
         self.path = path
 
-    def mapping(self, value: Any, span: Span, what: str, keys: tuple[str, ...]) -> YMap:
+    def mapping(self, value: Any, span: Span, what: str, keys: tuple[str, ...],
+                elsewhere: dict[str, str] | None = None) -> YMap:
+        """``value`` as a mapping of ``keys``; an unknown key that ``elsewhere`` names is
+        refused with its hint, where it belongs (`give_way` beside a robot's `robot:`)."""
         m = yamlpos.expect_map(value, span, WorldError, what)
+        stray = next((k for k in m if k not in keys), None)
+        if elsewhere and stray in elsewhere:
+            raise WorldError(f"unknown key `{stray}` in {what}", span=m.key_span(stray),
+                             expected="one of " + ", ".join(keys), hint=elsewhere[stray])
         yamlpos.check_keys(m, keys, WorldError, what)
         return m
 
@@ -152,6 +162,13 @@ class _Reader:
             if default is None:
                 return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return default
+        if m[key] is None or isinstance(m[key], (list, dict)):   # "unknown model ``" said
+            one_of = "one of " + ", ".join(options)
+            raise WorldError(f"`{key}` in {what} must be {one_of}, not "        # nothing
+                             f"{yamlpos.as_written(m[key], m.value_span(key))}",
+                             span=m.value_span(key), expected=one_of,
+                             hint=f"write `{key}: {options[0]}`" if len(options) == 1 else
+                             f"write one of them, or leave `{key}` out" if default else None)
         value = _as_written(m[key])
         if value not in options:
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
@@ -163,20 +180,26 @@ class _Reader:
                              else err.hint)
         return value
 
-    def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
+    def flag(self, m: YMap, key: str, what: str, default: bool, whose: str = "") -> bool:
         """``true`` or ``false`` (every yes/no key of a world: ``known``, ``brake``); ``1``
-        and YAML 1.1's ``yes``/``no``/``on``/``off`` are refused where they stand."""
+        and YAML 1.1's ``yes``/``no``/``on``/``off`` are refused where they stand. A value
+        that is nothing (``null``, ``~``, empty) is quoted as written, and the hint says what
+        leaving the key out takes: ``default``, ``whose`` it is (``the first robot's``)."""
         if key not in m:
             return default
         value = m[key]
         if not isinstance(value, bool):
+            span = m.value_span(key)
             meant = yamlpos.yaml11_bool(value)
+            left_out = (f"; left out, `{key}` is {_as_written(default)}"
+                        + (f" ({whose})" if whose else ""))
             hint = (f"write `{key}: {str(meant).lower()}`: only true and false are yes/no "
                     f"values here (YAML 1.2), `{value}` is text" if meant is not None else
-                    did_you_mean(str(value), ("true", "false"))
-                    or f"write `{key}: true` or `{key}: false`")
-            raise WorldError(f"`{key}` in {what} must be true or false, not `{value}`",
-                             span=m.value_span(key), expected="true or false", hint=hint)
+                    (isinstance(value, str) and did_you_mean(value, ("true", "false")))
+                    or f"write `{key}: true` or `{key}: false`{left_out}")
+            raise WorldError(f"`{key}` in {what} must be true or false, not "
+                             f"{yamlpos.as_written(value, span)}",
+                             span=span, expected="true or false", hint=hint)
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
@@ -186,46 +209,83 @@ class _Reader:
         return lo + 0.0, hi + 0.0       # [0, -0.0]: a draw from it refused -0.0 below 0.0
 
 
+def _example(m: YMap, key: str) -> str:
+    """``key``'s value as written, for a hint that moves it (``...`` for a list or mapping)."""
+    value = m[key]
+    return "..." if value is None or isinstance(value, (list, dict)) else _as_written(value)
+
+
+def _robot_keys_elsewhere(m: Any, under: str) -> dict[str, str]:
+    """Where a robot's key written outside a `robot:` belongs: `give_way: false` beside a
+    `robots:` item's `name` was "unknown key" with no word of its `robot:` (``under``: which
+    `robot:`), and at the top of the file it was offered `seed`."""
+    if not isinstance(m, YMap):
+        return {}
+    return {k: f"`{k}` is a key of the robot itself: write it under {under}, as "
+               f"`robot: {{{k}: {_example(m, k)}}}`" for k in ROBOT_KEYS if k in m}
+
+
+def _shared_keys_elsewhere(first: bool) -> dict[str, str]:
+    """Where a key of a `robot:` block (``first``: the top one) or of a `robots:` item
+    belongs that is not the robot's: the world's keys, and the item's."""
+    hints = {k: f"`{k}` is the world's, the same for every robot: write it at the top level "
+                f"of the file" for k in SHARED_KEYS}
+    if first:
+        hints.update({k: f"`{k}` is not the robot's: write it at the top level of the file, "
+                         f"beside `robot:`" for k in ("q_init", "q_goal", "robots")})
+        hints["name"] = ("the first robot is named `robot`; the world's other robots are "
+                         "named in their `robots:` items (and `name` at the top level names "
+                         "the world)")
+    else:
+        hints.update({k: f"`{k}` is the `robots:` item's: write it beside `robot:`, not "
+                         f"under it" for k in AGENT_KEYS})
+    return hints
+
+
 def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
-               dt: float | None = None) -> Robot:
-    m = r.mapping(value, span, "robot", ROBOT_KEYS)
+               dt: float | None = None, who: str = "robot") -> Robot:
+    """A `robot:` block; ``base``: the robot whose keys it changes (a `robots:` item's, the
+    first robot), ``who``: the robot it is, for the messages (``robot `b```)."""
+    m = r.mapping(value, span, who, ROBOT_KEYS, _shared_keys_elsewhere(base is None))
     d = base or Robot()
+    foot, steer = (("robot footprint", "robot steering") if who == "robot" else
+                   (f"the footprint of {who}", f"the steering of {who}"))
     if base is None or "model" in m:
-        r.choice(m, "model", MODELS, "robot")
+        r.choice(m, "model", MODELS, who)
     fp = d.length, d.width
     if "footprint" in m:
-        f = r.mapping(m["footprint"], m.value_span("footprint"), "robot footprint",
-                      ("length", "width"))
-        fp = (r.number(f, "length", "robot footprint", positive=True),
-              r.number(f, "width", "robot footprint", positive=True))
+        f = r.mapping(m["footprint"], m.value_span("footprint"), foot, ("length", "width"))
+        fp = (r.number(f, "length", foot, positive=True),
+              r.number(f, "width", foot, positive=True))
     elif base is None:
         yamlpos.require(m, "footprint", WorldError, "robot")
     st = YMap()
     st.span, st.key_spans, st.value_spans = m.span, {}, {}
     if "steering" in m:
-        st = r.mapping(m["steering"], m.value_span("steering"), "robot steering", STEERING_KEYS)
-    smin = r.number(st, "min", "robot steering", d.steering_min, minimum=0, maximum=180)
-    smax = r.number(st, "max", "robot steering", d.steering_max, minimum=0, maximum=180)
-    straight = r.number(st, "straight", "robot steering", d.steering_straight)
+        st = r.mapping(m["steering"], m.value_span("steering"), steer, STEERING_KEYS)
+    smin = r.number(st, "min", steer, d.steering_min, minimum=0, maximum=180)
+    smax = r.number(st, "max", steer, d.steering_max, minimum=0, maximum=180)
+    straight = r.number(st, "straight", steer, d.steering_straight)
     if not smin < straight < smax:
         raise WorldError(f"steering needs min < straight < max, not {smin:g} < {straight:g} "
                          f"< {smax:g}", span=st.span)
-    wheelbase = r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
+    wheelbase = r.number(m, "wheelbase", who, None if base is None else d.wheelbase,
                          positive=True)
     _check_wheelbase(m, wheelbase, fp[0])
+    whose = "" if base is None else "the first robot's"
     robot = Robot(
         model="tricycle",
         wheelbase=wheelbase,
         length=fp[0], width=fp[1],
-        safety_margin=r.number(m, "safety_margin", "robot", d.safety_margin, minimum=0),
+        safety_margin=r.number(m, "safety_margin", who, d.safety_margin, minimum=0),
         steering_min=smin, steering_max=smax, steering_straight=straight,
-        max_steering_rate=r.number(st, "max_rate", "robot steering", d.max_steering_rate,
+        max_steering_rate=r.number(st, "max_rate", steer, d.max_steering_rate,
                                    positive=True),
-        max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
-        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
-        max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
-        brake=r.flag(m, "brake", "robot", d.brake),
-        give_way=r.flag(m, "give_way", "robot", d.give_way))
+        max_speed=r.number(m, "max_speed", who, d.max_speed, positive=True),
+        acceleration=r.number(m, "acceleration", who, d.acceleration, positive=True),
+        max_reverse=r.number(m, "max_reverse", who, d.max_reverse, minimum=0),
+        brake=r.flag(m, "brake", who, d.brake, whose),
+        give_way=r.flag(m, "give_way", who, d.give_way, whose))
     _check_turn(m, st, robot)
     if dt is not None:
         _check_tick(m, robot, dt)
@@ -493,7 +553,8 @@ def parse_world(text: str, path: str) -> World:
     doc = yamlpos.load(text, path, WorldError)
     _not_a_termset(doc, Span.in_text(text, path, 1, 1))
     _not_a_map(doc, Span.in_text(text, path, 1, 1))
-    top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
+    top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS,
+                    _robot_keys_elsewhere(doc, "`robot:`"))
     name = _name(top)
     seed = _seed(r, top)
     dt, limit, substeps = _timing(r, top)
@@ -592,15 +653,23 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
     agent_spans = [(top.value_span("q_init"), top.value_span("q_goal"))]
     for i, item in enumerate(_list(top, "robots")):
         span = top["robots"].item_span(i)
-        a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
+        named = item.get("name") if isinstance(item, YMap) else None
+        who = (f"robot `{named}`" if isinstance(named, str) and named.strip()
+               and named.isprintable() else f"robot {i + 2}")       # (its name is checked below)
+        a = r.mapping(item, span, who, AGENT_KEYS,
+                      {**_shared_keys_elsewhere(False),
+                       **_robot_keys_elsewhere(item, "this robot's `robot:`")})
         aname = (_label(a, f"robot {i + 2}'s", "oncoming (it heads its column and CSV rows)")
                  if "name" in a else f"robot{i + 2}")
-        if any(b.name == aname for b in agents):
-            raise WorldError(f"two robots are named `{aname}` (the first robot is `robot`): "
-                             "give each a name of its own",
-                             span=a.value_span("name") if "name" in a else span)
-        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot, dt) if "robot" in a
-                  else robot)
+        _check_agent_name(a, aname, agents, span)
+        if "robot" in a and a["robot"] is None:
+            raise WorldError(f"the `robot:` of `{aname}` is empty", span=a.value_span("robot"),
+                             expected="the robot keys it changes, such as "
+                                      "`robot: {max_speed: 40}`",
+                             hint=f"or leave `robot:` out: `{aname}` is then the same robot "
+                                  "as the first")
+        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot, dt,
+                             f"robot `{aname}`") if "robot" in a else robot)
         agents.append(Agent(aname, arobot,
                             read_pose(r, yamlpos.require(a, "q_init", WorldError, f"robot `{aname}`"),
                                       a.value_span("q_init"), f"q_init of `{aname}`"),
@@ -610,6 +679,25 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
     agents = [replace(agent, start_span=s, goal_span=g)
               for agent, (s, g) in zip(agents, agent_spans)]
     return agents, agent_spans
+
+
+def _check_agent_name(a: YMap, aname: str, agents: list[Agent], span: Span) -> None:
+    """Refuse a robot's name that another robot has, or that heads the summary table's
+    column of all the robots (``all robots``); an unnamed robot is named by its place
+    (``robot3``), which a named one may have taken."""
+    if aname == "all robots":
+        raise WorldError("`all robots` heads the summary's column of every robot: a robot "
+                         "cannot be named so", span=a.value_span("name"),
+                         hint="name: oncoming (it heads its column and CSV rows)")
+    if not any(b.name == aname for b in agents):
+        return
+    if "name" not in a:
+        raise WorldError(f"this robot has no `name`, so it is called `{aname}`, as an earlier "
+                         f"robot is named", span=span,
+                         hint="give it a name of its own: `name: ...`")
+    first = " (the first robot, under `robot:`, is `robot`)" if aname == "robot" else ""
+    raise WorldError(f"two robots are named `{aname}`{first}: give each a name of its own",
+                     span=a.value_span("name"))
 
 
 #: the most corridor points a world may have in all: each corridor piece's walls are clipped by

@@ -1,0 +1,183 @@
+"""A world file's `robots:` as a new user writes it, and breaks it: each message names the
+robot, quotes what was written, and says where a key in the wrong block belongs
+(worlds/README.md, "The format, annotated" and the errors after "Several robots")."""
+
+from __future__ import annotations
+
+import pytest
+
+from mitos_cli.errors import WorldError
+from mitos_cli.sim.worldfile import parse_world
+
+# the first robot, and `b` coming the other way; ITEM is the rest of `b`'s item
+WORLD = """\
+name: t
+dt: 0.05
+time_limit: 10
+robot:
+  model: tricycle
+  wheelbase: 16
+  footprint: {length: 24, width: 18}
+TOP
+q_init: {x: 30, y: -10}
+q_goal: {x: 570, y: -10}
+robots:
+  - name: b
+    q_init: {x: 570, y: 10, heading: 180}
+    q_goal: {x: 30, y: 10}
+ITEM
+map:
+  corridors:
+    - points: [[0, 0], [600, 0]]
+      width: 90
+"""
+
+
+def world(item: str = "", top: str = "") -> str:
+    return WORLD.replace("ITEM\n", item).replace("TOP\n", top)
+
+
+def error(text: str) -> str:
+    with pytest.raises(WorldError) as info:
+        parse_world(text, "w.yaml")
+    return info.value.render()
+
+
+def test_the_world_loads_and_b_takes_its_own_keys():
+    w = parse_world(world("    robot: {max_speed: 40, give_way: false}\n"), "w.yaml")
+    assert [a.name for a in w.agents] == ["robot", "b"]
+    assert (w.agents[1].robot.max_speed, w.agents[1].robot.give_way) == (40, False)
+    assert (w.agents[0].robot.max_speed, w.agents[0].robot.give_way) == (60, True)
+
+
+@pytest.mark.parametrize("key", ["give_way", "brake"])
+@pytest.mark.parametrize("written, said", [
+    ("null", "`null`"), ("~", "`~`"), ("", "nothing (an empty value)"),
+    ('""', 'the empty text `""`'), ("[true]", "a list")])
+def test_a_flag_of_nothing_is_quoted_as_written_and_the_default_named(key, written, said):
+    """`give_way: null` read "not `None`" (Python's word; `brake` the same, through the one
+    flag reader); the hint now says what leaving it out takes."""
+    text = error(world(f"    robot:\n      {key}: {written}\n"))
+    assert f"world error: `{key}` in robot `b` must be true or false, not {said}\n" in text
+    assert (f"hint: write `{key}: true` or `{key}: false`; left out, `{key}` is true "
+            f"(the first robot's)") in text
+    assert "w.yaml:15:" in text and "None" not in text
+    text = error(world(top=f"  {key}: {written}\n"))           # the first robot's own
+    assert f"`{key}` in robot must be true or false, not {said}\n" in text
+    assert text.endswith(f"; left out, `{key}` is true")
+
+
+@pytest.mark.parametrize("key, value", [("give_way", "false"), ("max_speed", "40"),
+                                        ("footprint", "{length: 20, width: 14}"),
+                                        ("brake", "false"), ("wheelbase", "12")])
+def test_a_robot_key_beside_an_items_robot_says_it_belongs_under_it(key, value):
+    """A `robot:` key written at a `robots:` item's level was "unknown key" with no word of
+    the item's `robot:`."""
+    text = error(world(f"    {key}: {value}\n"))
+    shown = "..." if value.startswith("{") else value
+    assert f"w.yaml:14:5: world error: unknown key `{key}` in robot `b`\n" in text
+    assert (f"hint: `{key}` is a key of the robot itself: write it under this robot's "
+            f"`robot:`, as `robot: {{{key}: {shown}}}`") in text
+
+
+@pytest.mark.parametrize("key, value", [("give_way", "false"), ("max_speed", "40")])
+def test_a_robot_key_at_the_top_of_the_file_says_it_belongs_under_robot(key, value):
+    """At the top level `max_speed` was offered "did you mean `seed`?"."""
+    text = error(world(top=f"{key}: {value}\n"))
+    assert f"w.yaml:8:1: world error: unknown key `{key}` in the world file\n" in text
+    assert (f"hint: `{key}` is a key of the robot itself: write it under `robot:`, as "
+            f"`robot: {{{key}: {value}}}`") in text
+    assert "did you mean" not in text
+
+
+@pytest.mark.parametrize("key, value", [("q_init", "{x: 570, y: 10}"), ("q_goal", "{x: 1, y: 1}"),
+                                        ("name", "c")])
+def test_an_item_key_under_its_robot_says_it_belongs_beside_it(key, value):
+    text = error(world(f"    robot:\n      {key}: {value}\n"))
+    assert f"w.yaml:15:7: world error: unknown key `{key}` in robot `b`\n" in text
+    assert f"hint: `{key}` is the `robots:` item's: write it beside `robot:`, not under it" \
+        in text
+
+
+@pytest.mark.parametrize("key", ["q_init", "name", "robots"])
+def test_a_key_under_the_first_robot_says_where_it_belongs(key):
+    text = error(world(top=f"  {key}: x\n"))
+    assert f"unknown key `{key}` in robot\n" in text
+    assert ("the first robot is named `robot`" if key == "name" else
+            f"`{key}` is not the robot's: write it at the top level of the file") in text
+
+
+@pytest.mark.parametrize("where", ["item", "robot"])
+@pytest.mark.parametrize("key", ["sensors", "behavior", "dt"])
+def test_a_world_key_under_a_robot_says_it_is_the_worlds(where, key):
+    """Every robot of a world has the world's sensors, behavior and tick."""
+    block = f"    {key}: x\n" if where == "item" else f"    robot:\n      {key}: x\n"
+    text = error(world(block))
+    assert f"unknown key `{key}` in robot `b`" in text
+    assert (f"hint: `{key}` is the world's, the same for every robot: write it at the top "
+            "level of the file") in text
+
+
+def test_a_misspelt_key_still_gets_did_you_mean():
+    assert "did you mean `give_way`?" in error(world("    robot: {givway: false}\n"))
+    assert "did you mean `q_init`?" in error(world("    q_int: {x: 1, y: 1}\n"))
+
+
+@pytest.mark.parametrize("key, value, said", [
+    ("max_speed", "null", "`max_speed` in robot `b` must be a number, not `null`"),
+    ("max_speed", "0", "`max_speed` in robot `b` must be positive, not 0"),
+    ("footprint", "{length: 20}", "missing `width` in the footprint of robot `b`"),
+    ("footprint", "null", "the footprint of robot `b` must be a mapping"),
+    ("steering", "{min: 30, max: 150, max_rate: 0}",
+     "`max_rate` in the steering of robot `b` must be positive, not 0"),
+    ("model", "null", "`model` in robot `b` must be one of tricycle, not `null`")])
+def test_a_robots_own_keys_name_the_robot(key, value, said):
+    """In a world of eight robots "`max_speed` in robot must be ..." did not say whose."""
+    assert said in error(world(f"    robot: {{{key}: {value}}}\n"))
+
+
+def test_an_empty_robot_block_says_to_leave_it_out():
+    """`robot:` with nothing under it read "robot must be a mapping"."""
+    for written in ("null", ""):
+        text = error(world(f"    robot: {written}\n"))
+        assert "world error: the `robot:` of `b` is empty" in text
+        assert "hint: or leave `robot:` out: `b` is then the same robot as the first" in text
+
+
+def test_an_unnamed_robot_whose_place_name_is_taken_is_told_so():
+    """The third robot, unnamed, is `robot3`; a second named `robot3` made the third's error
+    read "two robots are named `robot3`" at an item that names none."""
+    text = error(world("  - q_init: {x: 300, y: 30}\n    q_goal: {x: 100, y: 30}\n")
+                 .replace("name: b", "name: robot3"))
+    assert "w.yaml:14:5: world error: this robot has no `name`, so it is called `robot3`" in text
+    assert "hint: give it a name of its own: `name: ...`" in text
+
+
+def test_a_robot_named_all_robots_is_refused():
+    """`all robots` heads the table's column of every robot: a robot of that name made two."""
+    text = error(world().replace("name: b", "name: all robots"))
+    assert "w.yaml:11:11: world error: `all robots` heads the summary's column" in text
+
+
+def test_a_robot_named_robot_says_the_first_is():
+    text = error(world().replace("name: b", "name: robot"))
+    assert "two robots are named `robot` (the first robot, under `robot:`, is `robot`)" in text
+
+
+def test_the_command_refuses_a_misplaced_give_way_with_exit_1(tmp_path, capsys):
+    """The whole message as `mitos simulate` prints it: file:line:column, the line, a caret,
+    what was expected and where the key belongs; exit 1, no traceback."""
+    from mitos_cli.cli.app import main
+
+    p = tmp_path / "fleet.yaml"
+    p.write_text(world("    give_way: false\n"), encoding="utf-8")
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", str(p)])
+    assert info.value.code == 1
+    assert capsys.readouterr().err == (
+        f"{p}:14:5: world error: unknown key `give_way` in robot `b`\n"
+        "        give_way: false\n"
+        "        ^\n"
+        "expected one of name, q_init, q_goal, robot\n"
+        "hint: `give_way` is a key of the robot itself: write it under this robot's `robot:`, "
+        "as `robot: {give_way: false}`\n")
