@@ -181,3 +181,37 @@ def test_the_command_refuses_a_misplaced_give_way_with_exit_1(tmp_path, capsys):
         "expected one of name, q_init, q_goal, robot\n"
         "hint: `give_way` is a key of the robot itself: write it under this robot's `robot:`, "
         "as `robot: {give_way: false}`\n")
+
+
+def test_two_goals_no_two_bodies_can_stand_at_are_refused():
+    """`b`'s goal on the first robot's with a tolerance of 1 in (the first's 12): whichever
+    arrived first parked in the other's way, and the run drove on to its time limit
+    (`TIMEOUT (robot timeout, b success) after 60.00 s`)."""
+    text = error(world().replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 570, y: -10, tolerance: 1}"))
+    assert ("w.yaml:13:13: world error: the goals (q_goal) of `robot` at (570, -10) and `b` at "
+            "(570, -10) are too close for both robots to stand at them: 0.0 in apart, with "
+            "tolerances of 12 and 1 in, the two centres are at most 13.0 in apart there, and the "
+            "bodies need 18 in (half of each one's narrower side): whichever arrives first "
+            "parks in the other's way\n") in text
+    assert "hint: move the goals 5 in or more farther apart, or widen a tolerance" in text
+    # 5 in apart, the centres may stand 18 in apart: taken; so are two goals of 12 in each
+    assert parse_world(world().replace("q_goal: {x: 30, y: 10}",
+                                       "q_goal: {x: 575, y: -10, tolerance: 1}"), "w.yaml")
+    assert parse_world(world().replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 570, y: -10}"),
+                       "w.yaml")
+
+
+def test_a_goal_inside_a_robot_parked_from_its_start_is_refused():
+    """A robot that starts within its goal's tolerance stands there from the first tick; a
+    goal inside its body was driven at until the time limit. A goal inside the start of a
+    robot that drives off is taken: it leaves."""
+    parked = "  - {name: parked, q_init: {x: 300, y: 20, heading: 90}, q_goal: {x: 300, y: 25}}\n"
+    text = error(world(parked).replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 300, y: 25}"))
+    assert ("w.yaml:13:13: world error: the goal (q_goal) of `b` at (300, 25) is taken by "
+            "`parked`, which starts within its own goal's tolerance and so stands there from "
+            "the first tick: within 12 in of the goal, `b`'s centre comes at most 5.1 in from "
+            "`parked`'s body, and its own body needs 9 in\n") in text
+    assert "hint: move the goal, or start `parked` farther from its own goal" in text
+    leaves = parked.replace("q_goal: {x: 300, y: 25}", "q_goal: {x: 500, y: 20}")
+    assert parse_world(world(leaves).replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 300, y: 25}"),
+                       "w.yaml")

@@ -574,6 +574,7 @@ def parse_world(text: str, path: str) -> World:
                   top.value_span("behavior") if "behavior" in top else None)
     static = check_free(world, agent_spans)
     check_starts(world, [s for s, _ in agent_spans])
+    check_goals(world, [g for _, g in agent_spans])
     if "randomise" in top:
         check_jitters(world, top["randomise"].get("obstacles"))
     notes = [*(grid.notes if grid else ()), *(given.notes if given else ()),
@@ -1276,6 +1277,77 @@ def check_starts(world: World, spans: list[Span]) -> None:
                 raise WorldError(f"{where} the robot's body overlaps robot `{other.name}`'s "
                                  "at its start", span=span,
                                  hint="start the robots further apart")
+
+
+def check_goals(world: World, spans: list[Span]) -> None:
+    """Refuse two robots that cannot both stand at their goals: a robot at its goal parks
+    there, an obstacle to the others, so the run could never end in success (two goals 0 in
+    apart with tolerances of 12 and 1 in drove on to the time limit, as did a goal inside a
+    robot that starts within its own goal's tolerance and so is parked from the first
+    tick). ``spans``: each robot's goal, in the order of the world's agents."""
+    for j, b in enumerate(world.agents):
+        for i, a in enumerate(world.agents[:j]):
+            for p, q, span in ((a, b, spans[j]), (b, a, spans[i])):
+                found = _goal_taken(p, q)
+                if found:
+                    raise WorldError(found[0], span=span, hint=found[1])
+
+
+def _parks_at_start(agent: Agent) -> bool:
+    """Whether ``agent`` starts within its goal's tolerance: arrived at the first tick, it
+    stays where it starts."""
+    st, g = agent.start, agent.goal
+    return math.hypot(st.x - g.x, st.y - g.y) <= g.tolerance
+
+
+#: points on a goal's tolerance circle looked at (:func:`_goal_taken`)
+GOAL_CIRCLE = 360
+
+
+def _goal_taken(p: Agent, q: Agent) -> tuple[str, str] | None:
+    """Why ``q`` can never stand at its goal while ``p`` stands at its own, or None. A robot
+    stands at its goal with its centre anywhere within the tolerance, turned any way, so
+    only what every such pose must touch is refused: the disc of half its narrower side
+    about its centre (half its width, as :func:`_check_goal_room` keeps from walls)."""
+    import numpy as np
+
+    r = min(q.robot.length, q.robot.width) / 2
+    g, t = q.goal, q.goal.tolerance
+    if _parks_at_start(q):
+        return None                    # (parked at both starts: check_starts refused it)
+    if _parks_at_start(p):
+        # the farthest that q's centre gets from p's body: on the circle of its tolerance
+        # (the distance to a convex body is convex); between two of the points looked at
+        # it is at most pi t / GOAL_CIRCLE farther
+        st, body = p.start, p.robot
+        h = math.radians(st.heading)
+        a = np.linspace(0.0, 2 * math.pi, GOAL_CIRCLE, endpoint=False)
+        dx, dy = g.x + t * np.cos(a) - st.x, g.y + t * np.sin(a) - st.y
+        along = np.abs(dx * math.cos(h) + dy * math.sin(h)) - body.length / 2
+        across = np.abs(-dx * math.sin(h) + dy * math.cos(h)) - body.width / 2
+        far = float(np.hypot(np.maximum(along, 0.0), np.maximum(across, 0.0)).max())
+        far += math.pi * t / GOAL_CIRCLE
+        if far >= r:
+            return None
+        return (f"the goal (q_goal) of `{q.name}` at ({g.x:g}, {g.y:g}) is taken by "
+                f"`{p.name}`, which starts within its own goal's tolerance and so stands "
+                f"there from the first tick: within {t:g} in of the goal, `{q.name}`'s "
+                f"centre comes at most {far:.1f} in from `{p.name}`'s body, and its own body "
+                f"needs {r:g} in",
+                f"move the goal, or start `{p.name}` farther from its own goal")
+    rp = min(p.robot.length, p.robot.width) / 2
+    pg, tp = p.goal, p.goal.tolerance
+    apart = math.hypot(g.x - pg.x, g.y - pg.y)
+    if apart + t + tp >= r + rp:
+        return None
+    return (f"the goals (q_goal) of `{p.name}` at ({pg.x:g}, {pg.y:g}) and `{q.name}` at "
+            f"({g.x:g}, {g.y:g}) are too close for both robots to stand at them: "
+            f"{apart:.1f} in apart, with tolerances of {tp:g} and {t:g} in, the two centres "
+            f"are at most {apart + tp + t:.1f} in apart there, and the bodies need {r + rp:g} "
+            f"in (half of each one's narrower side): whichever arrives first parks in the "
+            f"other's way",
+            f"move the goals {math.ceil(r + rp - tp - t - apart - 1e-9)} in or more farther "
+            f"apart, or widen a tolerance")
 
 
 def check_jitters(world: World, written: YMap) -> None:
