@@ -153,6 +153,15 @@ def test_an_unnamed_robot_whose_place_name_is_taken_is_told_so():
     assert "hint: give it a name of its own: `name: ...`" in text
 
 
+def test_a_name_taken_by_an_unnamed_robots_place_says_so():
+    """An unnamed `b` is `robot2`; a third named `robot2` read "two robots are named
+    `robot2`", though the file names only one so."""
+    text = error(world("  - {name: robot2, q_init: {x: 300, y: 30}, q_goal: {x: 100, y: 30}}\n")
+                 .replace("  - name: b\n    q_init", "  - q_init"))
+    assert ("w.yaml:13:12: world error: two robots are named `robot2` (an earlier robot has no "
+            "`name` and is called `robot2` by its place): give each a name of its own") in text
+
+
 def test_a_robot_named_all_robots_is_refused():
     """`all robots` heads the table's column of every robot: a robot of that name made two."""
     text = error(world().replace("name: b", "name: all robots"))

@@ -652,6 +652,7 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
                      top.value_span("q_goal"), "q_goal")
     agents = [Agent("robot", robot, start, goal)]
     agent_spans = [(top.value_span("q_init"), top.value_span("q_goal"))]
+    unnamed: set[str] = set()                   # the names given by place (`robot3`)
     for i, item in enumerate(_list(top, "robots")):
         span = top["robots"].item_span(i)
         named = item.get("name") if isinstance(item, YMap) else None
@@ -662,7 +663,9 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
                        **_robot_keys_elsewhere(item, "this robot's `robot:`")})
         aname = (_label(a, f"robot {i + 2}'s", "oncoming (it heads its column and CSV rows)")
                  if "name" in a else f"robot{i + 2}")
-        _check_agent_name(a, aname, agents, span)
+        _check_agent_name(a, aname, agents, span, unnamed)
+        if "name" not in a:
+            unnamed.add(aname)
         if "robot" in a and a["robot"] is None:
             raise WorldError(f"the `robot:` of `{aname}` is empty", span=a.value_span("robot"),
                              expected="the robot keys it changes, such as "
@@ -682,10 +685,11 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
     return agents, agent_spans
 
 
-def _check_agent_name(a: YMap, aname: str, agents: list[Agent], span: Span) -> None:
+def _check_agent_name(a: YMap, aname: str, agents: list[Agent], span: Span,
+                      unnamed: set[str]) -> None:
     """Refuse a robot's name that another robot has, or that heads the summary table's
     column of all the robots (``all robots``); an unnamed robot is named by its place
-    (``robot3``), which a named one may have taken."""
+    (``robot3``, and ``unnamed`` holds those names), which a named one may have taken."""
     if aname == "all robots":
         raise WorldError("`all robots` heads the summary's column of every robot: a robot "
                          "cannot be named so", span=a.value_span("name"),
@@ -696,7 +700,9 @@ def _check_agent_name(a: YMap, aname: str, agents: list[Agent], span: Span) -> N
         raise WorldError(f"this robot has no `name`, so it is called `{aname}`, as an earlier "
                          f"robot is named", span=span,
                          hint="give it a name of its own: `name: ...`")
-    first = " (the first robot, under `robot:`, is `robot`)" if aname == "robot" else ""
+    first = (" (the first robot, under `robot:`, is `robot`)" if aname == "robot" else
+             f" (an earlier robot has no `name` and is called `{aname}` by its place)"
+             if aname in unnamed else "")
     raise WorldError(f"two robots are named `{aname}`{first}: give each a name of its own",
                      span=a.value_span("name"))
 
