@@ -224,3 +224,11 @@ def test_a_goal_inside_a_robot_parked_from_its_start_is_refused():
     leaves = parked.replace("q_goal: {x: 300, y: 25}", "q_goal: {x: 500, y: 20}")
     assert parse_world(world(leaves).replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 300, y: 25}"),
                        "w.yaml")
+
+
+def test_give_way_false_under_the_first_robot_holds_for_every_robot_that_sets_none():
+    """As worlds/README.md says (a user leaving the first robot out left all of them out)."""
+    w = parse_world(world("    robot: {give_way: true}\n", top="  give_way: false\n"), "w.yaml")
+    assert [a.robot.give_way for a in w.agents] == [False, True]
+    w = parse_world(world(top="  give_way: false\n"), "w.yaml")
+    assert [a.robot.give_way for a in w.agents] == [False, False]
