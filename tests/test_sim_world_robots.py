@@ -232,3 +232,27 @@ def test_give_way_false_under_the_first_robot_holds_for_every_robot_that_sets_no
     assert [a.robot.give_way for a in w.agents] == [False, True]
     w = parse_world(world(top="  give_way: false\n"), "w.yaml")
     assert [a.robot.give_way for a in w.agents] == [False, False]
+
+
+@pytest.mark.parametrize("part, said", [
+    ("robots:\n  - {name: b, q_init: {x: 30, y: 8}, q_goal: {x: 570, y: 8}}\n",
+     "w.yaml:11:23: world error: at the start (q_init) of `b`, (30, 8) heading 0 deg, the "
+     "robot's body touches robot `robot`'s at its start (a touch is a contact: the run would "
+     "end in a collision at its first tick)"),
+    ("obstacles:\n  - {name: box, shape: circle, at: [50, -10], radius: 8}\n",
+     "w.yaml:8:9: world error: at the start (q_init), (30, -10) heading 0 deg, the robot's body "
+     "(24 x 18 in) touches obstacle `box` (a touch is a contact"),
+    ("obstacles:\n  - {name: crate, shape: rectangle, at: [30, -28], length: 10, width: 18}\n",
+     "touches obstacle `crate` (a touch is a contact")])
+def test_a_start_touching_a_robot_or_an_obstacle_is_refused_as_one_reaching_in(part, said):
+    """A body touching another robot's or an obstacle at its start was taken ("touching is
+    not reaching in") and the run read `COLLISION ... after 0.00 s`: a touch is a contact
+    (clearance 0), as a start touching a wall was refused already."""
+    text = WORLD.replace("TOP\n", "").replace("ITEM\n", "")
+    head, _, rest = text.partition("robots:\n")
+    rest = rest.partition("map:\n")[2]
+    text = error(head + part + "map:\n" + rest)
+    assert said in text, text
+    apart = part.replace("y: 8}", "y: 9}").replace("[50, -10]", "[51, -10]").replace(
+        "[30, -28]", "[30, -29]")
+    assert parse_world(head + apart + "map:\n" + rest, "w.yaml")

@@ -1238,22 +1238,33 @@ def _body_corners(agent: Agent) -> np.ndarray:
 
 
 def _box_meets(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
-              at: tuple[float, float]) -> bool:
+              at: tuple[float, float], touching: bool = False) -> bool:
     """Whether obstacle ``o`` standing at ``at`` reaches into the box ``[-hl, hl] x [-hw, hw]``
-    centred at ``centre`` and turned ``heading`` rad (touching is not reaching in)."""
+    centred at ``centre`` and turned ``heading`` rad (touching is not reaching in, unless
+    ``touching``: a robot's body at its start, where a touch is a contact)."""
+    return _box_gap(hl, hw, centre, heading, o, at) < 0.0 or \
+        touching and _box_gap(hl, hw, centre, heading, o, at) <= 0.0
+
+
+def _box_gap(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
+             at: tuple[float, float]) -> float:
+    """The signed distance from the box of :func:`_box_meets` to obstacle ``o`` at ``at``:
+    the gap, 0 touching, minus the depth where it reaches in."""
     import math
 
     import numpy as np
 
-    from .geometry import box_polygon_depth, rect_corners
+    from .geometry import box_polygon_distance, rect_corners
 
     c, s = math.cos(heading), math.sin(heading)
     turn = np.array([[c, -s], [s, c]])                      # world -> box frame: @ turn
     if o.shape == "circle":
         x, y = (np.asarray(at, float) - centre) @ turn
-        return math.hypot(max(abs(x) - hl, 0.0), max(abs(y) - hw, 0.0)) < o.radius
+        dx, dy = abs(x) - hl, abs(y) - hw
+        inside = min(max(dx, dy), 0.0)                      # the box's signed distance
+        return math.hypot(max(dx, 0.0), max(dy, 0.0)) + inside - o.radius
     corners = rect_corners(at[0], at[1], math.radians(o.angle), o.length, o.width)
-    return bool(box_polygon_depth(hl, hw, ((corners - centre) @ turn)[None])[0] > 0.0)
+    return float(box_polygon_distance(hl, hw, ((corners - centre) @ turn)[None])[0])
 
 
 def check_starts(world: World, spans: list[Span]) -> None:
@@ -1263,8 +1274,9 @@ def check_starts(world: World, spans: list[Span]) -> None:
 
     import numpy as np
 
-    from .geometry import box_polygon_depth
+    from .geometry import box_polygon_distance
 
+    touch = " (a touch is a contact: the run would end in a collision at its first tick)"
     for i, (agent, span) in enumerate(zip(world.agents, spans)):
         st, robot = agent.start, agent.robot
         hl, hw, h = robot.length / 2, robot.width / 2, math.radians(st.heading)
@@ -1272,17 +1284,22 @@ def check_starts(world: World, spans: list[Span]) -> None:
         where = (f"at the start (q_init){_who(agent)}, ({st.x:g}, {st.y:g}) heading "
                  f"{st.heading:g} deg,")
         for o in world.obstacles:
-            if _box_meets(hl, hw, centre, h, o, (o.x, o.y)):
+            gap = _box_gap(hl, hw, centre, h, o, (o.x, o.y))
+            if gap <= 0.0:              # (touching ended the run at 0.00 s, a collision)
                 raise WorldError(f"{where} the robot's body ({robot.length:g} x "
-                                 f"{robot.width:g} in) reaches into obstacle `{o.name}`",
+                                 f"{robot.width:g} in) "
+                                 + (f"reaches into obstacle `{o.name}`" if gap < 0.0 else
+                                    f"touches obstacle `{o.name}`{touch}"),
                                  span=span, hint="move the start or the obstacle")
         c, s = math.cos(h), math.sin(h)
         for other in world.agents[:i]:
             local = (_body_corners(other) - centre) @ np.array([[c, -s], [s, c]])
-            if box_polygon_depth(hl, hw, local[None])[0] > 0.0:
-                raise WorldError(f"{where} the robot's body overlaps robot `{other.name}`'s "
-                                 "at its start", span=span,
-                                 hint="start the robots further apart")
+            gap = float(box_polygon_distance(hl, hw, local[None])[0])
+            if gap <= 0.0:
+                raise WorldError(f"{where} the robot's body "
+                                 + (f"overlaps robot `{other.name}`'s at its start" if gap < 0.0
+                                    else f"touches robot `{other.name}`'s at its start{touch}"),
+                                 span=span, hint="start the robots further apart")
 
 
 def check_goals(world: World, spans: list[Span]) -> None:
