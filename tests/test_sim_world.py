@@ -826,7 +826,8 @@ def test_a_wheelbase_longer_than_the_footprint_is_refused():
            "footprint (24 in long)" in text and "expected a wheelbase of at most 24 in" in text
     other = BASE + ("robots:\n  - name: b\n    q_init: {x: 30, y: 20}\n    q_goal: {x: 300, y: 20}\n"
                     "    robot: {footprint: {length: 12, width: 10}}\n")
-    assert "the wheelbase (16 in) is longer" in error(other)     # inherited, then too long
+    assert "the wheelbase (16 in, the first robot's, which this robot takes) is longer" in \
+        error(other)                                              # inherited, then too long
     assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 24"), "w.yaml")
 
 

@@ -256,3 +256,15 @@ def test_a_start_touching_a_robot_or_an_obstacle_is_refused_as_one_reaching_in(p
     apart = part.replace("y: 8}", "y: 9}").replace("[50, -10]", "[51, -10]").replace(
         "[30, -28]", "[30, -29]")
     assert parse_world(head + apart + "map:\n" + rest, "w.yaml")
+
+
+def test_a_short_footprint_under_the_first_robots_wheelbase_says_whose_it_is():
+    """`robot: {footprint: {length: 10, width: 8}}` under the first robot's 16 in wheelbase
+    was told "shorten `wheelbase`", a key the item does not have."""
+    text = error(world("    robot: {footprint: {length: 10, width: 8}}\n"))
+    assert ("w.yaml:14:24: world error: the wheelbase (16 in, the first robot's, which this "
+            "robot takes) is longer than the robot's footprint (10 in long)") in text
+    assert ("hint: give this robot its own `wheelbase` (at most 10 in) beside its `footprint`, "
+            "or lengthen the footprint") in text
+    assert parse_world(world("    robot: {footprint: {length: 10, width: 8}, wheelbase: 8}\n"),
+                       "w.yaml").agents[1].robot.wheelbase == 8

@@ -271,7 +271,7 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
                          f"< {smax:g}", span=st.span)
     wheelbase = r.number(m, "wheelbase", who, None if base is None else d.wheelbase,
                          positive=True)
-    _check_wheelbase(m, wheelbase, fp[0])
+    _check_wheelbase(m, wheelbase, fp[0], inherited=base is not None and "wheelbase" not in m)
     whose = "" if base is None else "the first robot's"
     robot = Robot(
         model="tricycle",
@@ -348,17 +348,22 @@ def _check_turn(m: YMap, st: YMap, robot: Robot) -> None:
                           "wider")
 
 
-def _check_wheelbase(m: YMap, wheelbase: float, length: float) -> None:
+def _check_wheelbase(m: YMap, wheelbase: float, length: float, inherited: bool = False) -> None:
     """Refuse a wheelbase longer than the footprint: the rear axle and the front wheel are on
     the robot, and a body shorter than its wheelbase (`wheelbase: 40` under a 24 in footprint)
-    turns like a long robot while it collides like a short one."""
+    turns like a long robot while it collides like a short one. ``inherited``: the wheelbase
+    is the first robot's, taken by a `robots:` item that gave only its footprint (the hint
+    said "shorten `wheelbase`", which that item does not have)."""
     if wheelbase > length:
         key = "wheelbase" if "wheelbase" in m else "footprint"
-        raise WorldError(f"the wheelbase ({wheelbase:g} in) is longer than the robot's footprint "
-                         f"({length:g} in long): its wheels must fit under its body",
+        whose = ", the first robot's, which this robot takes" if inherited else ""
+        raise WorldError(f"the wheelbase ({wheelbase:g} in{whose}) is longer than the robot's "
+                         f"footprint ({length:g} in long): its wheels must fit under its body",
                          span=m.value_span(key) if key in m else m.span,
                          expected=f"a wheelbase of at most {length:g} in",
-                         hint="shorten `wheelbase`, or lengthen `footprint: {length: ...}`")
+                         hint=f"give this robot its own `wheelbase` (at most {length:g} in) "
+                              "beside its `footprint`, or lengthen the footprint" if inherited
+                         else "shorten `wheelbase`, or lengthen `footprint: {length: ...}`")
 
 
 def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
