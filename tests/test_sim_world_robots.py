@@ -268,3 +268,27 @@ def test_a_short_footprint_under_the_first_robots_wheelbase_says_whose_it_is():
             "or lengthen the footprint") in text
     assert parse_world(world("    robot: {footprint: {length: 10, width: 8}, wheelbase: 8}\n"),
                        "w.yaml").agents[1].robot.wheelbase == 8
+
+
+@pytest.mark.parametrize("corridors, goal, said", [
+    ("    - points: [[1000, 0], [1200, 0]]\n      width: 90\n", "{x: 1100, y: 0}",
+     "w.yaml:13:13: world error: robot `b`: the corridors do not connect the start to the goal"),
+    ("    - points: [[600, 0], [700, 0]]\n      width: 15\n"
+     "    - points: [[700, 0], [800, 0]]\n      width: 90\n", "{x: 780, y: 0}",
+     "w.yaml:13:13: world error: robot `b`: the only way to the goal passes (645, 0)")])
+def test_a_fleet_robot_without_a_route_is_named(corridors, goal, said):
+    """"the corridors do not connect the start to the goal" did not say whose, in a world of
+    several robots (the line did, at `b`'s q_goal)."""
+    from mitos_cli.sim.loop import prepare
+
+    def refusal(text: str) -> str:
+        with pytest.raises(WorldError) as info:
+            prepare(parse_world(text, "w.yaml"))
+        return info.value.render()
+
+    wider = world().replace("      width: 90\n", "      width: 90\n" + corridors)
+    assert said in refusal(wider.replace("q_goal: {x: 30, y: 10}", f"q_goal: {goal}"))
+    head, _, rest = wider.replace("q_goal: {x: 570, y: -10}", f"q_goal: {goal}").partition(
+        "robots:\n")
+    alone = refusal(head + "map:" + rest.partition("map:")[2])
+    assert "world error: the " in alone and "robot `" not in alone    # one robot: as it was
