@@ -292,3 +292,20 @@ def test_a_fleet_robot_without_a_route_is_named(corridors, goal, said):
         "robots:\n")
     alone = refusal(head + "map:" + rest.partition("map:")[2])
     assert "world error: the " in alone and "robot `" not in alone    # one robot: as it was
+
+
+@pytest.mark.parametrize("where, block, said", [
+    ("item", "    heading: 180\n",
+     "hint: `heading` is the start's: write it in `q_init`, as `q_init: {x: ..., y: ..., "
+     "heading: 180}`"),
+    ("item", "    tolerance: 3\n",
+     "hint: `tolerance` is the goal's: write it in `q_goal`, as `q_goal: {x: ..., y: ..., "
+     "tolerance: 3}`"),
+    ("robot", "    robot: {tolerance: 3}\n", "hint: `tolerance` is the goal's"),
+    ("top", "heading: 90\n", "hint: `heading` is the start's: write it in `q_init`, as "
+     "`q_init: {x: ..., y: ..., heading: 90}`"),
+    ("item", "    x: 5\n", "hint: `x` is a coordinate of `q_init` or `q_goal`")])
+def test_a_starts_or_goals_key_beside_it_says_where_it_belongs(where, block, said):
+    """`heading: 180` beside a `robots:` item's `q_init` was "unknown key" with no hint."""
+    text = error(world(top=block) if where == "top" else world(block))
+    assert said in text, text

@@ -225,11 +225,25 @@ def _robot_keys_elsewhere(m: Any, under: str) -> dict[str, str]:
                f"`robot: {{{k}: {_example(m, k)}}}`" for k in ROBOT_KEYS if k in m}
 
 
-def _shared_keys_elsewhere(first: bool) -> dict[str, str]:
+def _pose_keys_elsewhere(m: Any) -> dict[str, str]:
+    """Where a start's or a goal's key written beside them belongs (``heading: 180`` beside
+    a `robots:` item's `q_init`), with the value as written."""
+    if not isinstance(m, YMap):
+        return {}
+    shown = {k: _example(m, k) for k in ("heading", "tolerance") if k in m}
+    return {"heading": f"`heading` is the start's: write it in `q_init`, as `q_init: {{x: ..., "
+                       f"y: ..., heading: {shown.get('heading')}}}`",
+            "tolerance": f"`tolerance` is the goal's: write it in `q_goal`, as `q_goal: {{x: "
+                         f"..., y: ..., tolerance: {shown.get('tolerance')}}}`",
+            **{k: f"`{k}` is a coordinate of `q_init` or `q_goal`: write it in one, as "
+                  f"`q_init: {{x: ..., y: ...}}`" for k in ("x", "y")}}
+
+
+def _shared_keys_elsewhere(first: bool, m: Any) -> dict[str, str]:
     """Where a key of a `robot:` block (``first``: the top one) or of a `robots:` item
     belongs that is not the robot's: the world's keys, and the item's."""
     hints = {k: f"`{k}` is the world's, the same for every robot: write it at the top level "
-                f"of the file" for k in SHARED_KEYS}
+                f"of the file" for k in SHARED_KEYS} | _pose_keys_elsewhere(m)
     if first:
         hints.update({k: f"`{k}` is not the robot's: write it at the top level of the file, "
                          f"beside `robot:`" for k in ("q_init", "q_goal", "robots")})
@@ -246,7 +260,7 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
                dt: float | None = None, who: str = "robot") -> Robot:
     """A `robot:` block; ``base``: the robot whose keys it changes (a `robots:` item's, the
     first robot), ``who``: the robot it is, for the messages (``robot `b```)."""
-    m = r.mapping(value, span, who, ROBOT_KEYS, _shared_keys_elsewhere(base is None))
+    m = r.mapping(value, span, who, ROBOT_KEYS, _shared_keys_elsewhere(base is None, value))
     d = base or Robot()
     foot, steer = (("robot footprint", "robot steering") if who == "robot" else
                    (f"the footprint of {who}", f"the steering of {who}"))
@@ -559,7 +573,7 @@ def parse_world(text: str, path: str) -> World:
     _not_a_termset(doc, Span.in_text(text, path, 1, 1))
     _not_a_map(doc, Span.in_text(text, path, 1, 1))
     top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS,
-                    _robot_keys_elsewhere(doc, "`robot:`"))
+                    _pose_keys_elsewhere(doc) | _robot_keys_elsewhere(doc, "`robot:`"))
     name = _name(top)
     seed = _seed(r, top)
     dt, limit, substeps = _timing(r, top)
@@ -664,7 +678,7 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
         who = (f"robot `{named}`" if isinstance(named, str) and named.strip()
                and named.isprintable() else f"robot {i + 2}")       # (its name is checked below)
         a = r.mapping(item, span, who, AGENT_KEYS,
-                      {**_shared_keys_elsewhere(False),
+                      {**_shared_keys_elsewhere(False, item),
                        **_robot_keys_elsewhere(item, "this robot's `robot:`")})
         aname = (_label(a, f"robot {i + 2}'s", "oncoming (it heads its column and CSV rows)")
                  if "name" in a else f"robot{i + 2}")
