@@ -309,3 +309,11 @@ def test_a_starts_or_goals_key_beside_it_says_where_it_belongs(where, block, sai
     """`heading: 180` beside a `robots:` item's `q_init` was "unknown key" with no hint."""
     text = error(world(top=block) if where == "top" else world(block))
     assert said in text, text
+
+
+def test_half_a_footprint_in_an_item_offers_the_first_robots_other_side():
+    """`robot: {footprint: {width: 14}}`: the steering's keys are taken one by one from the
+    first robot, a footprint's are not; "add `length: ...`" did not say what it had been."""
+    text = error(world("    robot: {footprint: {width: 14}}\n"))
+    assert "w.yaml:14:24: world error: missing `length` in the footprint of robot `b`\n" in text
+    assert "hint: add `length: 24` to keep the first robot's length" in text

@@ -269,6 +269,12 @@ def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
     fp = d.length, d.width
     if "footprint" in m:
         f = r.mapping(m["footprint"], m.value_span("footprint"), foot, ("length", "width"))
+        side = next((k for k in ("length", "width") if k not in f), None)
+        if base is not None and side is not None:   # (steering's keys are taken one by one)
+            raise WorldError(f"missing `{side}` in {foot}", span=f.span,
+                             expected="a footprint's length and width both",
+                             hint=f"add `{side}: {getattr(d, side):g}` to keep the first "
+                                  f"robot's {side}")
         fp = (r.number(f, "length", foot, positive=True),
               r.number(f, "width", foot, positive=True))
     elif base is None:
