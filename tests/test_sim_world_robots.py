@@ -317,3 +317,21 @@ def test_half_a_footprint_in_an_item_offers_the_first_robots_other_side():
     text = error(world("    robot: {footprint: {width: 14}}\n"))
     assert "w.yaml:14:24: world error: missing `length` in the footprint of robot `b`\n" in text
     assert "hint: add `length: 24` to keep the first robot's length" in text
+
+
+FIXED = ("randomise moves obstacles and the sensor noise, not the robots: each robot starts at "
+         "its `q_init`")
+
+
+@pytest.mark.parametrize("randomise, said", [
+    ("randomise:\n  obstacles:\n    b: {dx: [-10, 10]}\n", f"hint: `b` is a robot: {FIXED}"),
+    ("randomise:\n  robots:\n    b: {dx: [-10, 10]}\n", f"hint: {FIXED}"),
+    ("randomise:\n  q_init: {dx: [-10, 10]}\n", f"hint: {FIXED}")])
+def test_randomising_a_robot_says_randomise_moves_obstacles(randomise, said):
+    """A robot's name under `randomise: obstacles:` was "unknown key" offered the obstacles'
+    names, and `randomise: robots:` no hint at all."""
+    box = "obstacles:\n  - {name: box, shape: circle, at: [300, 30], radius: 5}\n"
+    text = error(world() + box + randomise)
+    assert said in text, text
+    none = error(world() + randomise.replace("robots", "obstacles"))   # and no obstacles
+    assert f"hint: {FIXED}" in none

@@ -459,16 +459,25 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
     return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion, known)
 
 
-def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Randomise:
-    m = r.mapping(value, span, "randomise", RANDOMISE_KEYS)
+def read_randomise(r: _Reader, value: Any, span: Span, names: list[str],
+                   robots: tuple[str, ...] = ()) -> Randomise:
+    """``randomise``: each named obstacle's offsets and the sensor noise (``robots``: the
+    robots' names, which a user may give it: it does not move them)."""
+    fixed = ("randomise moves obstacles and the sensor noise, not the robots: each robot "
+             "starts at its `q_init`")
+    m = r.mapping(value, span, "randomise", RANDOMISE_KEYS,
+                  {k: fixed for k in ("robots", "robot", "q_init", "q_goal")})
     jitters = []
     if "obstacles" in m:
         if not names and m["obstacles"]:       # not "expected one of" nothing
             raise WorldError("randomise moves obstacles, and the world has none",
                              span=m.value_span("obstacles"),
-                             hint="add them under `obstacles:`, or drop `randomise: obstacles`")
+                             hint=fixed if isinstance(m["obstacles"], YMap) and any(
+                                 k in robots for k in m["obstacles"]) else
+                             "add them under `obstacles:`, or drop `randomise: obstacles`")
         obs = r.mapping(m["obstacles"], m.value_span("obstacles"), "randomise obstacles",
-                        tuple(names))
+                        tuple(names), {k: f"`{k}` is a robot: {fixed}" for k in robots
+                                       if k not in names})
         for name, spec in obs.items():
             _check_offsets(spec, name)
             j = r.mapping(spec, obs.value_span(name), f"randomise of `{name}`", ("dx", "dy"))
@@ -591,7 +600,7 @@ def parse_world(text: str, path: str) -> World:
     min_clearance, replan = _route(r, top, agents)
     obstacles = _obstacles(r, top, dt)
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"),
-                                [o.name for o in obstacles])
+                                [o.name for o in obstacles], tuple(a.name for a in agents))
                  if "randomise" in top else Randomise())
     world = World(name, path, seed, dt, limit, substeps, tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
