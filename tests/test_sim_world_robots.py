@@ -335,3 +335,19 @@ def test_randomising_a_robot_says_randomise_moves_obstacles(randomise, said):
     assert said in text, text
     none = error(world() + randomise.replace("robots", "obstacles"))   # and no obstacles
     assert f"hint: {FIXED}" in none
+
+
+@pytest.mark.parametrize("block, said", [
+    ("top:max_sped: 40\n", "hint: did you mean `max_speed`? `max_speed` is a key of the robot "
+     "itself: write it under `robot:`"),
+    ("    giveway: false\n", "hint: did you mean `give_way`? `give_way` is a key of the robot "
+     "itself: write it under this robot's `robot:`"),
+    ("    robot: {q_gaol: {x: 1, y: 2}}\n", "hint: did you mean `q_goal`? `q_goal` is the "
+     "`robots:` item's: write it beside `robot:`, not under it"),
+    ("    robto: {max_speed: 3}\n", "hint: did you mean `robot`?\n"),
+    ("top:robtos: []\n", "hint: did you mean `robots`?")])
+def test_a_misspelt_key_of_another_block_is_offered_with_where_it_belongs(block, said):
+    """`max_sped: 40` at the top of the file was offered `name` (the closest top key); the
+    closest key of any block is offered, with where it goes."""
+    text = error(world(top=block[4:]) if block.startswith("top:") else world(block))
+    assert said in text + "\n", text

@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import MitosError, NameError_, Span, WorldError, did_you_mean, unknown
+from ..errors import MitosError, NameError_, Span, WorldError, closest, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
 from .safety import TIGHTEST_TURN, fastest_point, full_lock, swing_words, tightest_turn
@@ -112,9 +112,13 @@ class _Reader:
         refused with its hint, where it belongs (`give_way` beside a robot's `robot:`)."""
         m = yamlpos.expect_map(value, span, WorldError, what)
         stray = next((k for k in m if k not in keys), None)
-        if elsewhere and stray in elsewhere:
-            raise WorldError(f"unknown key `{stray}` in {what}", span=m.key_span(stray),
-                             expected="one of " + ", ".join(keys), hint=elsewhere[stray])
+        if elsewhere and stray is not None:
+            near = closest(stray, [*keys, *elsewhere]) if isinstance(stray, str) else None
+            hint = (elsewhere.get(stray) or near in elsewhere and near not in keys
+                    and f"did you mean `{near}`? {elsewhere[near]}")  # `max_sped`: not `seed`
+            if hint:
+                raise WorldError(f"unknown key `{stray}` in {what}", span=m.key_span(stray),
+                                 expected="one of " + ", ".join(keys), hint=hint)
         yamlpos.check_keys(m, keys, WorldError, what)
         return m
 
@@ -209,7 +213,7 @@ class _Reader:
         return lo + 0.0, hi + 0.0       # [0, -0.0]: a draw from it refused -0.0 below 0.0
 
 
-def _example(m: YMap, key: str) -> str:
+def _example(m: dict, key: str) -> str:
     """``key``'s value as written, for a hint that moves it (``...`` for a list or mapping)."""
     value = m[key]
     return "..." if value is None or isinstance(value, (list, dict)) else _as_written(value)
@@ -219,10 +223,10 @@ def _robot_keys_elsewhere(m: Any, under: str) -> dict[str, str]:
     """Where a robot's key written outside a `robot:` belongs: `give_way: false` beside a
     `robots:` item's `name` was "unknown key" with no word of its `robot:` (``under``: which
     `robot:`), and at the top of the file it was offered `seed`."""
-    if not isinstance(m, YMap):
-        return {}
+    written = m if isinstance(m, YMap) else {}
     return {k: f"`{k}` is a key of the robot itself: write it under {under}, as "
-               f"`robot: {{{k}: {_example(m, k)}}}`" for k in ROBOT_KEYS if k in m}
+               f"`robot: {{{k}: {_example(written, k) if k in written else '...'}}}`"
+            for k in ROBOT_KEYS}
 
 
 def _pose_keys_elsewhere(m: Any) -> dict[str, str]:
