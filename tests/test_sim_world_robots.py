@@ -351,3 +351,9 @@ def test_a_misspelt_key_of_another_block_is_offered_with_where_it_belongs(block,
     closest key of any block is offered, with where it goes."""
     text = error(world(top=block[4:]) if block.startswith("top:") else world(block))
     assert said in text + "\n", text
+
+
+def test_a_misspelt_heading_beside_q_init_is_offered_without_a_value_it_lacks():
+    text = error(world("    headng: 180\n"))
+    assert ("hint: did you mean `heading`? `heading` is the start's: write it in `q_init`, as "
+            "`q_init: {x: ..., y: ..., heading: ...}`") in text

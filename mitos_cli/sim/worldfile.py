@@ -232,13 +232,12 @@ def _robot_keys_elsewhere(m: Any, under: str) -> dict[str, str]:
 def _pose_keys_elsewhere(m: Any) -> dict[str, str]:
     """Where a start's or a goal's key written beside them belongs (``heading: 180`` beside
     a `robots:` item's `q_init`), with the value as written."""
-    if not isinstance(m, YMap):
-        return {}
-    shown = {k: _example(m, k) for k in ("heading", "tolerance") if k in m}
+    shown = {k: _example(m, k) if isinstance(m, YMap) and k in m else "..."
+             for k in ("heading", "tolerance")}
     return {"heading": f"`heading` is the start's: write it in `q_init`, as `q_init: {{x: ..., "
-                       f"y: ..., heading: {shown.get('heading')}}}`",
+                       f"y: ..., heading: {shown['heading']}}}`",
             "tolerance": f"`tolerance` is the goal's: write it in `q_goal`, as `q_goal: {{x: "
-                         f"..., y: ..., tolerance: {shown.get('tolerance')}}}`",
+                         f"..., y: ..., tolerance: {shown['tolerance']}}}`",
             **{k: f"`{k}` is a coordinate of `q_init` or `q_goal`: write it in one, as "
                   f"`q_init: {{x: ..., y: ...}}`" for k in ("x", "y")}}
 
@@ -1276,12 +1275,10 @@ def _body_corners(agent: Agent) -> np.ndarray:
 
 
 def _box_meets(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
-              at: tuple[float, float], touching: bool = False) -> bool:
+              at: tuple[float, float]) -> bool:
     """Whether obstacle ``o`` standing at ``at`` reaches into the box ``[-hl, hl] x [-hw, hw]``
-    centred at ``centre`` and turned ``heading`` rad (touching is not reaching in, unless
-    ``touching``: a robot's body at its start, where a touch is a contact)."""
-    return _box_gap(hl, hw, centre, heading, o, at) < 0.0 or \
-        touching and _box_gap(hl, hw, centre, heading, o, at) <= 0.0
+    centred at ``centre`` and turned ``heading`` rad (touching is not reaching in)."""
+    return _box_gap(hl, hw, centre, heading, o, at) < 0.0
 
 
 def _box_gap(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
