@@ -59,6 +59,8 @@ def test_without_a_value_it_says_where_the_rule_base_goes(capsys):
     # a misspelling keeps Typer's suggestion, an unknown option Click's answer
     (["simualte"], "No such command 'simualte'. Did you mean 'simulate'?"),
     (["simulate", "--output", "x.csv"], "No such option: --output (Possible options: --out)"),
+    # Click offered `--fps`
+    (["simulate", "slalom", "--csv"], "No such option: --csv. Did you mean --out FILE.csv?"),
     (["eval", "--frobnicate"], "No such option: --frobnicate"),
 ])
 def test_other_tools_names_get_ours(args, meant, capsys):
@@ -70,6 +72,8 @@ def test_other_tools_names_get_ours(args, meant, capsys):
 def test_a_peers_option_name_is_offered_only_where_the_command_has_ours(capsys):
     code, _, err = run_main(["check", "--csv", "x.csv"], capsys)
     assert code == 2 and "No such option: --csv" in err and "--batch" not in err
+    code, _, err = run_main(["compare", "slalom", "--csv"], capsys)     # its --out: a folder
+    assert code == 2 and "No such option: --csv" in err and "Did you mean" not in err
 
 
 words = st.text(st.characters(blacklist_categories=("Cs", "Cc")), min_size=1, max_size=12)

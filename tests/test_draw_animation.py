@@ -4,6 +4,7 @@ the formats refused with a clear message."""
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -193,3 +194,31 @@ def test_each_robot_of_an_animation_takes_its_colour_in_the_runs_picture():
     ((_, body),), (trail,) = _robot_patches(Figure().add_subplot(), alone, 1)
     assert (mc.to_hex(body.get_facecolor()), mc.to_hex(trail.get_color())) == (
         ROBOT_COLOUR, TRAIL_COLOUR)                     # one robot: blue, its trail green
+
+
+def test_each_robot_of_an_animation_is_named_at_its_goal_and_the_rules_are_the_firsts(tmp_path):
+    """In a world of several robots the animation named none (the runs' picture names each at
+    its goal), and its panel of fired rules did not say whose they were (the first robot's)."""
+    import matplotlib.colors as mc
+    from matplotlib.figure import Figure
+
+    from mitos_cli.draw.animation import _robot_patches, _Scene
+    from mitos_cli.draw.world import ROBOT_COLOURS
+    from mitos_cli.sim import load_world
+
+    world = load_world(Path(__file__).parent / "data" / "crossroads4.yaml")
+    ax = Figure().add_subplot()
+    _robot_patches(ax, world, 4)
+    assert [(t.get_text(), t.xy, mc.to_hex(t.get_color())) for t in ax.texts] == [
+        (a.name, (a.goal.x, a.goal.y), ROBOT_COLOURS[i]) for i, a in enumerate(world.agents)]
+    alone = Figure().add_subplot()
+    _robot_patches(alone, load_world(packaged_path("worlds", "corridor.yaml")), 1)
+    assert len(alone.texts) == 0                      # one robot: its goal is plain
+    from mitos_cli.sim import simulate
+    from mitos_cli.sim.export import explain
+    from mitos_cli.sim.planner import FuzzyPlanner
+
+    res = simulate(dataclasses.replace(world, time_limit=0.1))
+    scene = _Scene(res, explain(res, FuzzyPlanner()), 300, 100)
+    assert "fired rules of `robot`, the first robot, by DOF (the bar's length: 0 to 1)" in [
+        t.get_text() for a in scene.fig.axes for t in a.texts]

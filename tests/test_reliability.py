@@ -115,6 +115,15 @@ def test_map_settings_are_checked(tmp_path, extra, line):
     _positioned(info.value, line)
 
 
+@pytest.mark.parametrize("written, said", [("null", "`null`"), ("", "nothing (an empty value)"),
+                                           ('"0"', "`0`"), ("[0]", "a list")])
+def test_map_negate_of_nothing_is_quoted_as_written(tmp_path, written, said):
+    """`negate: null` read "not `None`", Python's word for it."""
+    with pytest.raises(WorldError) as info:
+        load_map_yaml(_map(tmp_path, f"negate: {written}\n"))
+    assert info.value.message == f"negate must be 0 or 1, not {said}"
+
+
 def test_map_negate_unquoted_still_reads(tmp_path):
     grid = load_map_yaml(_map(tmp_path, "negate: 1\n"))
     assert grid.occupied.sum() == 2

@@ -228,3 +228,29 @@ def test_two_robots_of_one_name_are_refused(tmp_path, capsys):
     assert info.value.code == 1
     assert f"{p}:12:11:" in err and "two robots are named `robot`" in err
     assert "- name: robot" in err and "Traceback" not in err
+
+
+def test_the_trace_of_a_fleet_says_whom_it_follows(rear_end):
+    """`--trace` follows the first robot; in a world of several it said nothing of the
+    others, whose ticks are in the --out CSV."""
+    text = run(rear_end, "--trace", "--every", "1000")
+    assert text.startswith("(the trace follows `robot`, the first of the world's 2 robots; "
+                           "`second` is in the --out CSV, a row per tick and robot)\n\n"
+                           "--- tick 0, t = 0.00 s: robot at (530.0, -15.0) in"), text[:300]
+    crossroads = run(ROOT / "tests" / "data" / "crossroads4.yaml", "--trace", "--every", "5000",
+                     "--planner", "dwa")
+    assert crossroads.startswith(
+        "(the trace follows `robot`, the first of the world's 4 robots; `west`, `north` and "
+        "`south` are in the --out CSV, a row per tick and robot)\n\n(planner dwa is not a rule "
+        "base: no DOF trace"), crossroads[:300]
+    single = run(ROOT / "worlds" / "corridor.yaml", "--trace", "--every", "5000")
+    assert single.startswith("--- tick 0,")
+
+
+def test_simulate_help_speaks_of_several_robots():
+    res = RUNNER.invoke(app, ["simulate", "--help"], env={"COLUMNS": "200"})
+    text = " ".join(res.stdout.replace("│", " ").split())
+    assert "Simulate the rule base driving one tricycle robot or several" in text
+    assert ("With several robots (a world's `robots:`), the verdict names each robot's "
+            "outcome") in text
+    assert "Write one CSV row per tick (and robot) to FILE.csv" in text

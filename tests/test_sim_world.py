@@ -588,9 +588,12 @@ def test_a_goal_the_body_cannot_reach_within_its_tolerance_is_refused():
     assert parse_world(gap + box % ", velocity: [0, 30]", "w.yaml")     # a cart drives off
 
 
-def test_an_empty_number_says_so():
-    msg = error(BASE.replace("time_limit: 10", "time_limit: ~"))
-    assert "w.yaml:4:13" in msg and "must be a number, not nothing (an empty value or `~`)" in msg
+@pytest.mark.parametrize("written, said", [("~", "`~`"), ("null", "`null`"),
+                                           ("", "nothing (an empty value)")])
+def test_an_empty_number_says_so(written, said):
+    """Nothing is quoted as written: `null` read "nothing (an empty value or `~`)"."""
+    msg = error(BASE.replace("time_limit: 10", f"time_limit: {written}"))
+    assert "w.yaml:4:" in msg and f"must be a number, not {said}\n" in msg, msg
 
 
 def test_a_name_with_a_control_character_is_refused():
@@ -823,7 +826,8 @@ def test_a_wheelbase_longer_than_the_footprint_is_refused():
            "footprint (24 in long)" in text and "expected a wheelbase of at most 24 in" in text
     other = BASE + ("robots:\n  - name: b\n    q_init: {x: 30, y: 20}\n    q_goal: {x: 300, y: 20}\n"
                     "    robot: {footprint: {length: 12, width: 10}}\n")
-    assert "the wheelbase (16 in) is longer" in error(other)     # inherited, then too long
+    assert "the wheelbase (16 in, the first robot's, which this robot takes) is longer" in \
+        error(other)                                              # inherited, then too long
     assert parse_world(BASE.replace("wheelbase: 16", "wheelbase: 24"), "w.yaml")
 
 

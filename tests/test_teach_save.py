@@ -291,6 +291,13 @@ def test_held_must_be_true_false_or_a_point():
     assert (err.value.span.line, err.value.span.column) == (6, 55)
     mid = parse_termset(text.replace("maybe", "5"), "x.yaml").variables[0].terms[0]
     assert (mid.held, mid.held_at) == (True, 5.0)
+    for written, said in (("null", "`null`"), ("~", "`~`"), ("[5]", "a list")):  # not `None`
+        with pytest.raises(TermSetError) as err:
+            parse_termset(text.replace("maybe", written), "x.yaml")
+        assert err.value.message.endswith(f"held at, not {said}")
+    with pytest.raises(TermSetError) as err:
+        parse_termset(text.replace("role: input", "role: null"), "x.yaml")
+    assert err.value.message.endswith("role must be `input` or `output`, not `null`")
 
 
 def test_a_centre_term_stays_held_when_its_neighbours_lose_their_symmetry(rules, tmp_path):

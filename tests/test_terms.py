@@ -97,6 +97,16 @@ def test_frozen_refuses_what_is_not_true_or_false(value):
     assert info.value.span.line == 6
 
 
+@pytest.mark.parametrize("value, said", [("null", "`null`"), ("~", "`~`"), ("[1]", "a list")])
+def test_frozen_of_nothing_is_quoted_as_written(value, said):
+    """`frozen: null` read "not `None`", Python's word for it (the worlds' flags did too)."""
+    from mitos_cli.errors import TermSetError
+
+    with pytest.raises(TermSetError) as info:
+        termset({"MID": f"{{shape: triangle, points: [2, 5, 8], frozen: {value}}}"})
+    assert info.value.message.endswith(f"`frozen` must be true or false, not {said}")
+
+
 @pytest.mark.parametrize("written", ["7.0e400", "-1.5E+999"])
 def test_a_number_past_a_floats_range_is_named_as_written(written):
     """YAML reads `7.0e400` as inf, and the error said "not `inf`" of a number the user

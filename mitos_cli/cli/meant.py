@@ -7,7 +7,7 @@ The mistakes users make are more often a habit from elsewhere:
   (``simulate`` and ``compare`` take ``--rulebase``; ``eval``, ``check``, ``teach``,
   ``convert``, ``export`` and ``plot`` take the rule base first; ``simulate`` and
   ``compare`` take their worlds as arguments): the answer is the command line as meant;
-- a peer's name for an option (``--csv`` for ``eval --batch``);
+- a peer's name for an option (``--csv`` for ``eval --batch``, for ``simulate --out``);
 - a command by another tool's name for it: MATLAB's ``gensurf``, ``plotmf`` and ``ruleview``
   for ``plot surface``, ``plot terms`` and ``plot rules``; ``train`` or ``run``.
 """
@@ -34,6 +34,9 @@ FIRST_ARGUMENT = {
 #: Peers' names of options -> ours, offered where the command has ours.
 OPTIONS = {"--csv": "--batch", "--input": "--batch", "--inputs": "--batch",
            "--in": "--batch", "--file": "--batch"}
+#: The same for one command, where its option of that name means something else
+#: (``simulate --csv``: Click offered `--fps`).
+COMMAND_OPTIONS = {"simulate": {"--csv": "--out FILE.csv"}}
 
 #: Other tools' names of commands -> ours, for each group (``""`` is ``mitos`` itself).
 COMMANDS = {
@@ -63,8 +66,8 @@ def option_meant(ctx: Context, args: list[str], exc: NoSuchOption) -> UsageError
             else "its worlds as arguments"
         return NoSuchOption(option, f"No such option: {option}. `{ctx.command_path}` takes "
                                     f"{takes}, not as an option{example}", ctx=ctx)
-    ours = OPTIONS.get(option)
-    if ours is not None and ours in option_names(ctx):
+    ours = COMMAND_OPTIONS.get(command, {}).get(option) or OPTIONS.get(option)
+    if ours is not None and ours.split()[0] in option_names(ctx):
         return NoSuchOption(option, f"No such option: {option}. Did you mean {ours}?", ctx=ctx)
     return exc
 

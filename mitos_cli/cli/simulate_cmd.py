@@ -223,7 +223,7 @@ def simulate_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON instead of the table.")] = False,
     out: Annotated[Optional[Path], typer.Option(
         "--out", "-o", parser=file_arg, metavar="FILE.csv",
-        help="Write one CSV row per tick to FILE.csv (a name ending in .csv).")] = None,
+        help="Write one CSV row per tick (and robot) to FILE.csv (a name ending in .csv).")] = None,
     trace: Annotated[bool, typer.Option(
         "--trace", help="Every --every ticks (and at each replan and the last tick), print "
                         "the pose, speed, steering, clearance and "
@@ -262,7 +262,12 @@ def simulate_command(
         help="Who drives: fuzzy (the rule base), potential_field or dwa (baselines that "
              "see the same readings and follow the same route).")] = "fuzzy",
 ) -> None:
-    """Simulate the rule base driving a tricycle robot through corridor worlds."""
+    """Simulate the rule base driving one tricycle robot or several through corridor worlds.
+
+    With several robots (a world's `robots:`), the verdict names each robot's outcome, the
+    table and --json give each robot's figures beside all robots', --runs a row per robot,
+    --out a row per tick and robot, --plot every robot's path; --trace follows the first.
+    """
     from ..resources import DEFAULT_WORLD
     from ..sim.planner import PLANNERS, make_planner, planner_kind
 

@@ -168,7 +168,9 @@ class _Scene:
         self.bars: list | None = None
         self.texts: list[_SlotText] | None = None
         if detail is not None:
-            self.bars, self.texts = _dof_panel(self.fig, fh, panel_h, dpi)
+            agents = result.world.agents
+            self.bars, self.texts = _dof_panel(self.fig, fh, panel_h, dpi,
+                                               agents[0].name if len(agents) > 1 else None)
 
     def draw(self, k: int) -> None:
         """The frame of tick ``k``."""
@@ -249,6 +251,9 @@ def _robot_patches(ax: Axes, world: World, n: int) -> tuple[list, list]:
         body = Polygon(np.zeros((4, 2)), closed=True, facecolor=colour, edgecolor="black",
                        lw=0.6, zorder=5)
         ax.add_patch(body)
+        if n > 1:                       # its name at its goal, as --plot writes it (no robot
+            ax.annotate(agent.name, (agent.goal.x, agent.goal.y), xytext=(6, -10),  # was named)
+                        textcoords="offset points", fontsize=8, color=colour, zorder=6)
         robots.append((agent.robot, body))
         trails.append(trail)
     return robots, trails
@@ -266,13 +271,16 @@ def _cone_collection(ax: Axes, bounds: tuple[float, float, float, float]) -> Pol
     return cones
 
 
-def _dof_panel(fig: Figure, fh: float, panel_h: float, dpi: int) -> tuple[list, list]:
-    """The panel of the fired rules under the map: :data:`BARS` bars and their texts."""
+def _dof_panel(fig: Figure, fh: float, panel_h: float, dpi: int,
+               who: str | None = None) -> tuple[list, list]:
+    """The panel of the fired rules under the map: :data:`BARS` bars and their texts;
+    ``who``: the robot whose rules they are, where there are several (the first's)."""
     bax = fig.add_axes((0.01, 0.05 / fh, 0.98, (panel_h - 0.1) / fh))
     bax.set_xlim(0, 1)
     bax.set_ylim(BARS - 0.5, -1.3)
     bax.set_axis_off()
-    bax.text(0.0, -1.0, "fired rules, by DOF (the bar's length: 0 to 1)", fontsize=7,
+    whose = f" of `{who}`, the first robot," if who is not None else ""
+    bax.text(0.0, -1.0, f"fired rules{whose} by DOF (the bar's length: 0 to 1)", fontsize=7,
              va="center", color="#333333")
     bars = bax.barh(range(BARS), np.zeros(BARS), color="#b8cbe6", height=0.8)
     return list(bars), [_SlotText(fig, bax, slot, dpi) for slot in range(BARS)]

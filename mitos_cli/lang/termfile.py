@@ -163,7 +163,8 @@ def _variable(name: str, spec: Any, key_span: Span, value_span: Span,
     yamlpos.check_keys(spec, VARIABLE_KEYS, TermSetError, what)
     role = yamlpos.require(spec, "role", TermSetError, what)
     if role not in ("input", "output"):
-        raise TermSetError(f"{what}: role must be `input` or `output`, not `{role}`",
+        raise TermSetError(f"{what}: role must be `input` or `output`, not "
+                           f"{yamlpos.as_written(role, spec.value_span('role'))}",
                            span=spec.value_span("role"), hint=did_you_mean(str(role),
                                                                          ["input", "output"]))
     universe = yamlpos.require(spec, "universe", TermSetError, what)
@@ -310,7 +311,8 @@ def _held(spec: YMap, what: str) -> tuple[bool, float | None]:
     if isinstance(value, (int, float)) and math.isfinite(value):
         return True, float(value)
     raise TermSetError(f"{what}: `held` must be true, false or the point the term is held at, "
-                       f"not `{value}`", span=spec.value_span("held"),
+                       f"not {yamlpos.as_written(value, spec.value_span('held'))}",
+                       span=spec.value_span("held"),
                        hint="`held: false` lets adaptation move a centre term off its point")
 
 
@@ -318,7 +320,8 @@ def _flag(spec: YMap, key: str, default: bool, what: str, hint: str) -> bool:
     """A yes/no key of a term: YAML's `true`/`false` only, since `"no"` would be truthy."""
     value = spec.get(key, default)
     if not isinstance(value, bool):
-        raise TermSetError(f"{what}: `{key}` must be true or false, not `{value}`",
+        raise TermSetError(f"{what}: `{key}` must be true or false, not "
+                           f"{yamlpos.as_written(value, spec.value_span(key))}",
                            span=spec.value_span(key), hint=hint)
     return value
 

@@ -438,9 +438,7 @@ def expect_number(value: Any, span: Span, error: type[MitosError], what: str, *,
     """``value`` as a finite float, or ``error`` saying a number was expected. ``units`` says
     what the file's numbers are in, for a number written with a unit (``16in``, ``50ms``)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        shown = ("nothing (an empty value or `~`)" if value is None else
-                 f"`{str(value).lower()}`" if isinstance(value, bool) else
-                 _quoted_number(value, span) or f"`{value}`")
+        shown = _quoted_number(value, span) or as_written(value, span)
         raise error(f"{what} must be a number, not {shown}", span=span,   # (YAML's `true`)
                     hint=_unit_hint(value, units))
     try:
@@ -488,6 +486,29 @@ def _quoted_number(value: Any, span: Span) -> str | None:
     except ValueError:
         return None
     return f"the text {text}: YAML reads a value in quotes as text; write the number without them"
+
+
+#: how YAML writes nothing (``null``, ``Null``, ``NULL``, ``~``)
+_NULLS = ("null", "Null", "NULL", "~")
+
+
+def as_written(value: Any, span: Span) -> str:
+    """``value`` (a value as loaded here) as the file wrote it, for "must be ..., not X":
+    `null` and `~` as written, an empty value as "nothing (an empty value)", a boolean as
+    `true`, a list or mapping as what it is (``give_way: null`` read "not `None`", Python's
+    word for it, and ``give_way: [true]`` "not `[True]`")."""
+    if value is None:
+        written = _written(span)
+        return f"`{written}`" if written in _NULLS else "nothing (an empty value)"
+    if isinstance(value, bool):
+        return f"`{str(value).lower()}`"
+    if isinstance(value, str) and not value:
+        return f"the empty text `{_written(span) or chr(34) * 2}`"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, dict):
+        return "a mapping"
+    return f"`{value}`"
 
 
 def _written(span: Span) -> str | None:

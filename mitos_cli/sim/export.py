@@ -120,6 +120,12 @@ def traces(result: SimResult, planner: Planner, every: int, digits: int = 1) -> 
         f"(planner {result.planner} is not a rule base: no DOF trace, only each tick's pose "
         f"and inputs)"]
     who = result.world.agents[0].name            # the first robot's trace ("robot" alone)
+    agents = result.world.agents
+    if len(agents) > 1:                           # (it said nothing of the others)
+        blocks.insert(0, f"(the trace follows `{who}`, the first of the world's "
+                         f"{len(agents)} robots; {_names([a.name for a in agents[1:]])} "
+                         f"{'is' if len(agents) == 2 else 'are'} in the --out CSV, a row per "
+                         f"tick and robot)")
     for k in ticks:
         if k < 0 or result.active is not None and not result.active[k, 0]:
             continue
@@ -130,9 +136,15 @@ def traces(result: SimResult, planner: Planner, every: int, digits: int = 1) -> 
         if detail is not None:
             lines += ["", trace_of(detail, k).render(digits)]
         blocks.append("\n".join(lines))
-    if len(blocks) == (detail is None):             # not a tick of its own: a bare blank line
+    if len(blocks) == (detail is None) + (len(agents) > 1):    # not a tick of its own
         blocks.append(f"({who} drove no tick: it stood at its goal from the start)")
     return "\n\n".join(blocks)
+
+
+def _names(names: list[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``, each in backquotes."""
+    quoted = [f"`{n}`" for n in names]
+    return quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " and " + quoted[-1]
 
 
 def _tick_head(result: SimResult, k: int, who: str) -> str:

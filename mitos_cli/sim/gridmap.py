@@ -142,7 +142,9 @@ def _negate(spec: yamlpos.YMap) -> bool:
     value = spec.get("negate", 0)
     if value in (0, 1) and not isinstance(value, float) or isinstance(value, bool):
         return bool(value)
-    raise WorldError(f"negate must be 0 or 1, not `{value}`", span=spec.value_span("negate"),
+    raise WorldError(f"negate must be 0 or 1, not "
+                     f"{yamlpos.as_written(value, spec.value_span('negate'))}",
+                     span=spec.value_span("negate"),
                      hint="write `negate: 0` (dark pixels are walls) or `negate: 1`, unquoted")
 
 

@@ -112,6 +112,8 @@ def prepare(world: World, between: bool = True) -> Scene:
             if exc.span is None:        # (a start it cannot leave, at the start's)
                 at_start = isinstance(exc, NarrowPassage) and exc.end == "start"
                 exc.span = a.start_span if at_start else a.goal_span
+                if len(world.agents) > 1:           # whose start and goal ("the corridors do
+                    exc.message = f"robot `{a.name}`: {exc.message}"   # not connect ...")
             raise
     return Scene(static, tuple(routes), given, knowledge.plan_grid(given, static, world))
 

@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import MitosError, NameError_, Span, WorldError, did_you_mean, unknown
+from ..errors import MitosError, NameError_, Span, WorldError, closest, did_you_mean, unknown
 from ..lang import yamlpos
 from ..lang.yamlpos import YList, YMap
 from .safety import TIGHTEST_TURN, fastest_point, full_lock, swing_words, tightest_turn
@@ -61,6 +61,9 @@ MODES = ("loop", "ping-pong", "stop")
 #: keys whose value is a thing of that name ("unknown shape `circel`" reads); for the others
 #: ("unknown unknown `ocupied`" does not) an error quotes `key: value`
 NOUN_KEYS = ("model", "layout", "shape", "mode")
+#: a world's keys that hold for all its robots (written under a robot, they are misplaced)
+SHARED_KEYS = tuple(k for k in TOP_KEYS if k not in ("name", "robot", "q_init", "q_goal",
+                                                     "robots"))
 
 
 #: The largest magnitude of any number in a world (inches, seconds, degrees): 1e7 in is
@@ -103,8 +106,19 @@ class _Reader:
     def __init__(self, path: str) -> None:
         self.path = path
 
-    def mapping(self, value: Any, span: Span, what: str, keys: tuple[str, ...]) -> YMap:
+    def mapping(self, value: Any, span: Span, what: str, keys: tuple[str, ...],
+                elsewhere: dict[str, str] | None = None) -> YMap:
+        """``value`` as a mapping of ``keys``; an unknown key that ``elsewhere`` names is
+        refused with its hint, where it belongs (`give_way` beside a robot's `robot:`)."""
         m = yamlpos.expect_map(value, span, WorldError, what)
+        stray = next((k for k in m if k not in keys), None)
+        if elsewhere and stray is not None:
+            near = closest(stray, [*keys, *elsewhere]) if isinstance(stray, str) else None
+            hint = (elsewhere.get(stray) or near in elsewhere and near not in keys
+                    and f"did you mean `{near}`? {elsewhere[near]}")  # `max_sped`: not `seed`
+            if hint:
+                raise WorldError(f"unknown key `{stray}` in {what}", span=m.key_span(stray),
+                                 expected="one of " + ", ".join(keys), hint=hint)
         yamlpos.check_keys(m, keys, WorldError, what)
         return m
 
@@ -152,6 +166,13 @@ class _Reader:
             if default is None:
                 return yamlpos.require(m, key, WorldError, what)   # raises: `key` is missing
             return default
+        if m[key] is None or isinstance(m[key], (list, dict)):   # "unknown model ``" said
+            one_of = "one of " + ", ".join(options)
+            raise WorldError(f"`{key}` in {what} must be {one_of}, not "        # nothing
+                             f"{yamlpos.as_written(m[key], m.value_span(key))}",
+                             span=m.value_span(key), expected=one_of,
+                             hint=f"write `{key}: {options[0]}`" if len(options) == 1 else
+                             f"write one of them, or leave `{key}` out" if default else None)
         value = _as_written(m[key])
         if value not in options:
             err = unknown(key, value, options)          # "unknown shape `circel`" ...
@@ -163,20 +184,26 @@ class _Reader:
                              else err.hint)
         return value
 
-    def flag(self, m: YMap, key: str, what: str, default: bool) -> bool:
+    def flag(self, m: YMap, key: str, what: str, default: bool, whose: str = "") -> bool:
         """``true`` or ``false`` (every yes/no key of a world: ``known``, ``brake``); ``1``
-        and YAML 1.1's ``yes``/``no``/``on``/``off`` are refused where they stand."""
+        and YAML 1.1's ``yes``/``no``/``on``/``off`` are refused where they stand. A value
+        that is nothing (``null``, ``~``, empty) is quoted as written, and the hint says what
+        leaving the key out takes: ``default``, ``whose`` it is (``the first robot's``)."""
         if key not in m:
             return default
         value = m[key]
         if not isinstance(value, bool):
+            span = m.value_span(key)
             meant = yamlpos.yaml11_bool(value)
+            left_out = (f"; left out, `{key}` is {_as_written(default)}"
+                        + (f" ({whose})" if whose else ""))
             hint = (f"write `{key}: {str(meant).lower()}`: only true and false are yes/no "
                     f"values here (YAML 1.2), `{value}` is text" if meant is not None else
-                    did_you_mean(str(value), ("true", "false"))
-                    or f"write `{key}: true` or `{key}: false`")
-            raise WorldError(f"`{key}` in {what} must be true or false, not `{value}`",
-                             span=m.value_span(key), expected="true or false", hint=hint)
+                    (isinstance(value, str) and did_you_mean(value, ("true", "false")))
+                    or f"write `{key}: true` or `{key}: false`{left_out}")
+            raise WorldError(f"`{key}` in {what} must be true or false, not "
+                             f"{yamlpos.as_written(value, span)}",
+                             span=span, expected="true or false", hint=hint)
         return value
 
     def range_pair(self, value: Any, span: Span, what: str) -> tuple[float, float]:
@@ -186,46 +213,102 @@ class _Reader:
         return lo + 0.0, hi + 0.0       # [0, -0.0]: a draw from it refused -0.0 below 0.0
 
 
+def _example(m: dict, key: str) -> str:
+    """``key``'s value as written, for a hint that moves it (``...`` for a list or mapping)."""
+    value = m[key]
+    return "..." if value is None or isinstance(value, (list, dict)) else _as_written(value)
+
+
+def _robot_keys_elsewhere(m: Any, under: str) -> dict[str, str]:
+    """Where a robot's key written outside a `robot:` belongs: `give_way: false` beside a
+    `robots:` item's `name` was "unknown key" with no word of its `robot:` (``under``: which
+    `robot:`), and at the top of the file it was offered `seed`."""
+    written = m if isinstance(m, YMap) else {}
+    return {k: f"`{k}` is a key of the robot itself: write it under {under}, as "
+               f"`robot: {{{k}: {_example(written, k) if k in written else '...'}}}`"
+            for k in ROBOT_KEYS}
+
+
+def _pose_keys_elsewhere(m: Any) -> dict[str, str]:
+    """Where a start's or a goal's key written beside them belongs (``heading: 180`` beside
+    a `robots:` item's `q_init`), with the value as written."""
+    shown = {k: _example(m, k) if isinstance(m, YMap) and k in m else "..."
+             for k in ("heading", "tolerance")}
+    return {"heading": f"`heading` is the start's: write it in `q_init`, as `q_init: {{x: ..., "
+                       f"y: ..., heading: {shown['heading']}}}`",
+            "tolerance": f"`tolerance` is the goal's: write it in `q_goal`, as `q_goal: {{x: "
+                         f"..., y: ..., tolerance: {shown['tolerance']}}}`",
+            **{k: f"`{k}` is a coordinate of `q_init` or `q_goal`: write it in one, as "
+                  f"`q_init: {{x: ..., y: ...}}`" for k in ("x", "y")}}
+
+
+def _shared_keys_elsewhere(first: bool, m: Any) -> dict[str, str]:
+    """Where a key of a `robot:` block (``first``: the top one) or of a `robots:` item
+    belongs that is not the robot's: the world's keys, and the item's."""
+    hints = {k: f"`{k}` is the world's, the same for every robot: write it at the top level "
+                f"of the file" for k in SHARED_KEYS} | _pose_keys_elsewhere(m)
+    if first:
+        hints.update({k: f"`{k}` is not the robot's: write it at the top level of the file, "
+                         f"beside `robot:`" for k in ("q_init", "q_goal", "robots")})
+        hints["name"] = ("the first robot is named `robot`; the world's other robots are "
+                         "named in their `robots:` items (and `name` at the top level names "
+                         "the world)")
+    else:
+        hints.update({k: f"`{k}` is the `robots:` item's: write it beside `robot:`, not "
+                         f"under it" for k in AGENT_KEYS})
+    return hints
+
+
 def read_robot(r: _Reader, value: Any, span: Span, base: Robot | None = None,
-               dt: float | None = None) -> Robot:
-    m = r.mapping(value, span, "robot", ROBOT_KEYS)
+               dt: float | None = None, who: str = "robot") -> Robot:
+    """A `robot:` block; ``base``: the robot whose keys it changes (a `robots:` item's, the
+    first robot), ``who``: the robot it is, for the messages (``robot `b```)."""
+    m = r.mapping(value, span, who, ROBOT_KEYS, _shared_keys_elsewhere(base is None, value))
     d = base or Robot()
+    foot, steer = (("robot footprint", "robot steering") if who == "robot" else
+                   (f"the footprint of {who}", f"the steering of {who}"))
     if base is None or "model" in m:
-        r.choice(m, "model", MODELS, "robot")
+        r.choice(m, "model", MODELS, who)
     fp = d.length, d.width
     if "footprint" in m:
-        f = r.mapping(m["footprint"], m.value_span("footprint"), "robot footprint",
-                      ("length", "width"))
-        fp = (r.number(f, "length", "robot footprint", positive=True),
-              r.number(f, "width", "robot footprint", positive=True))
+        f = r.mapping(m["footprint"], m.value_span("footprint"), foot, ("length", "width"))
+        side = next((k for k in ("length", "width") if k not in f), None)
+        if base is not None and side is not None:   # (steering's keys are taken one by one)
+            raise WorldError(f"missing `{side}` in {foot}", span=f.span,
+                             expected="a footprint's length and width both",
+                             hint=f"add `{side}: {getattr(d, side):g}` to keep the first "
+                                  f"robot's {side}")
+        fp = (r.number(f, "length", foot, positive=True),
+              r.number(f, "width", foot, positive=True))
     elif base is None:
         yamlpos.require(m, "footprint", WorldError, "robot")
     st = YMap()
     st.span, st.key_spans, st.value_spans = m.span, {}, {}
     if "steering" in m:
-        st = r.mapping(m["steering"], m.value_span("steering"), "robot steering", STEERING_KEYS)
-    smin = r.number(st, "min", "robot steering", d.steering_min, minimum=0, maximum=180)
-    smax = r.number(st, "max", "robot steering", d.steering_max, minimum=0, maximum=180)
-    straight = r.number(st, "straight", "robot steering", d.steering_straight)
+        st = r.mapping(m["steering"], m.value_span("steering"), steer, STEERING_KEYS)
+    smin = r.number(st, "min", steer, d.steering_min, minimum=0, maximum=180)
+    smax = r.number(st, "max", steer, d.steering_max, minimum=0, maximum=180)
+    straight = r.number(st, "straight", steer, d.steering_straight)
     if not smin < straight < smax:
         raise WorldError(f"steering needs min < straight < max, not {smin:g} < {straight:g} "
                          f"< {smax:g}", span=st.span)
-    wheelbase = r.number(m, "wheelbase", "robot", None if base is None else d.wheelbase,
+    wheelbase = r.number(m, "wheelbase", who, None if base is None else d.wheelbase,
                          positive=True)
-    _check_wheelbase(m, wheelbase, fp[0])
+    _check_wheelbase(m, wheelbase, fp[0], inherited=base is not None and "wheelbase" not in m)
+    whose = "" if base is None else "the first robot's"
     robot = Robot(
         model="tricycle",
         wheelbase=wheelbase,
         length=fp[0], width=fp[1],
-        safety_margin=r.number(m, "safety_margin", "robot", d.safety_margin, minimum=0),
+        safety_margin=r.number(m, "safety_margin", who, d.safety_margin, minimum=0),
         steering_min=smin, steering_max=smax, steering_straight=straight,
-        max_steering_rate=r.number(st, "max_rate", "robot steering", d.max_steering_rate,
+        max_steering_rate=r.number(st, "max_rate", steer, d.max_steering_rate,
                                    positive=True),
-        max_speed=r.number(m, "max_speed", "robot", d.max_speed, positive=True),
-        acceleration=r.number(m, "acceleration", "robot", d.acceleration, positive=True),
-        max_reverse=r.number(m, "max_reverse", "robot", d.max_reverse, minimum=0),
-        brake=r.flag(m, "brake", "robot", d.brake),
-        give_way=r.flag(m, "give_way", "robot", d.give_way))
+        max_speed=r.number(m, "max_speed", who, d.max_speed, positive=True),
+        acceleration=r.number(m, "acceleration", who, d.acceleration, positive=True),
+        max_reverse=r.number(m, "max_reverse", who, d.max_reverse, minimum=0),
+        brake=r.flag(m, "brake", who, d.brake, whose),
+        give_way=r.flag(m, "give_way", who, d.give_way, whose))
     _check_turn(m, st, robot)
     if dt is not None:
         _check_tick(m, robot, dt)
@@ -288,17 +371,22 @@ def _check_turn(m: YMap, st: YMap, robot: Robot) -> None:
                           "wider")
 
 
-def _check_wheelbase(m: YMap, wheelbase: float, length: float) -> None:
+def _check_wheelbase(m: YMap, wheelbase: float, length: float, inherited: bool = False) -> None:
     """Refuse a wheelbase longer than the footprint: the rear axle and the front wheel are on
     the robot, and a body shorter than its wheelbase (`wheelbase: 40` under a 24 in footprint)
-    turns like a long robot while it collides like a short one."""
+    turns like a long robot while it collides like a short one. ``inherited``: the wheelbase
+    is the first robot's, taken by a `robots:` item that gave only its footprint (the hint
+    said "shorten `wheelbase`", which that item does not have)."""
     if wheelbase > length:
         key = "wheelbase" if "wheelbase" in m else "footprint"
-        raise WorldError(f"the wheelbase ({wheelbase:g} in) is longer than the robot's footprint "
-                         f"({length:g} in long): its wheels must fit under its body",
+        whose = ", the first robot's, which this robot takes" if inherited else ""
+        raise WorldError(f"the wheelbase ({wheelbase:g} in{whose}) is longer than the robot's "
+                         f"footprint ({length:g} in long): its wheels must fit under its body",
                          span=m.value_span(key) if key in m else m.span,
                          expected=f"a wheelbase of at most {length:g} in",
-                         hint="shorten `wheelbase`, or lengthen `footprint: {length: ...}`")
+                         hint=f"give this robot its own `wheelbase` (at most {length:g} in) "
+                              "beside its `footprint`, or lengthen the footprint" if inherited
+                         else "shorten `wheelbase`, or lengthen `footprint: {length: ...}`")
 
 
 def read_sensors(r: _Reader, value: Any, span: Span) -> Sensors:
@@ -374,16 +462,25 @@ def read_obstacle(r: _Reader, value: Any, span: Span, index: int) -> Obstacle:
     return Obstacle(name, shape, at[0], at[1], radius, length, width, angle, motion, known)
 
 
-def read_randomise(r: _Reader, value: Any, span: Span, names: list[str]) -> Randomise:
-    m = r.mapping(value, span, "randomise", RANDOMISE_KEYS)
+def read_randomise(r: _Reader, value: Any, span: Span, names: list[str],
+                   robots: tuple[str, ...] = ()) -> Randomise:
+    """``randomise``: each named obstacle's offsets and the sensor noise (``robots``: the
+    robots' names, which a user may give it: it does not move them)."""
+    fixed = ("randomise moves obstacles and the sensor noise, not the robots: each robot "
+             "starts at its `q_init`")
+    m = r.mapping(value, span, "randomise", RANDOMISE_KEYS,
+                  {k: fixed for k in ("robots", "robot", "q_init", "q_goal")})
     jitters = []
     if "obstacles" in m:
         if not names and m["obstacles"]:       # not "expected one of" nothing
             raise WorldError("randomise moves obstacles, and the world has none",
                              span=m.value_span("obstacles"),
-                             hint="add them under `obstacles:`, or drop `randomise: obstacles`")
+                             hint=fixed if isinstance(m["obstacles"], YMap) and any(
+                                 k in robots for k in m["obstacles"]) else
+                             "add them under `obstacles:`, or drop `randomise: obstacles`")
         obs = r.mapping(m["obstacles"], m.value_span("obstacles"), "randomise obstacles",
-                        tuple(names))
+                        tuple(names), {k: f"`{k}` is a robot: {fixed}" for k in robots
+                                       if k not in names})
         for name, spec in obs.items():
             _check_offsets(spec, name)
             j = r.mapping(spec, obs.value_span(name), f"randomise of `{name}`", ("dx", "dy"))
@@ -493,7 +590,8 @@ def parse_world(text: str, path: str) -> World:
     doc = yamlpos.load(text, path, WorldError)
     _not_a_termset(doc, Span.in_text(text, path, 1, 1))
     _not_a_map(doc, Span.in_text(text, path, 1, 1))
-    top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS)
+    top = r.mapping(doc, Span.in_text(text, path, 1, 1), "the world file", TOP_KEYS,
+                    _pose_keys_elsewhere(doc) | _robot_keys_elsewhere(doc, "`robot:`"))
     name = _name(top)
     seed = _seed(r, top)
     dt, limit, substeps = _timing(r, top)
@@ -505,7 +603,7 @@ def parse_world(text: str, path: str) -> World:
     min_clearance, replan = _route(r, top, agents)
     obstacles = _obstacles(r, top, dt)
     randomise = (read_randomise(r, top["randomise"], top.value_span("randomise"),
-                                [o.name for o in obstacles])
+                                [o.name for o in obstacles], tuple(a.name for a in agents))
                  if "randomise" in top else Randomise())
     world = World(name, path, seed, dt, limit, substeps, tuple(agents), sensors,
                   tuple(corridors), grid, tuple(obstacles), randomise,
@@ -513,6 +611,7 @@ def parse_world(text: str, path: str) -> World:
                   top.value_span("behavior") if "behavior" in top else None)
     static = check_free(world, agent_spans)
     check_starts(world, [s for s, _ in agent_spans])
+    check_goals(world, [g for _, g in agent_spans])
     if "randomise" in top:
         check_jitters(world, top["randomise"].get("obstacles"))
     notes = [*(grid.notes if grid else ()), *(given.notes if given else ()),
@@ -590,17 +689,28 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
                      top.value_span("q_goal"), "q_goal")
     agents = [Agent("robot", robot, start, goal)]
     agent_spans = [(top.value_span("q_init"), top.value_span("q_goal"))]
+    unnamed: set[str] = set()                   # the names given by place (`robot3`)
     for i, item in enumerate(_list(top, "robots")):
         span = top["robots"].item_span(i)
-        a = r.mapping(item, span, f"robot {i + 2}", AGENT_KEYS)
+        named = item.get("name") if isinstance(item, YMap) else None
+        who = (f"robot `{named}`" if isinstance(named, str) and named.strip()
+               and named.isprintable() else f"robot {i + 2}")       # (its name is checked below)
+        a = r.mapping(item, span, who, AGENT_KEYS,
+                      {**_shared_keys_elsewhere(False, item),
+                       **_robot_keys_elsewhere(item, "this robot's `robot:`")})
         aname = (_label(a, f"robot {i + 2}'s", "oncoming (it heads its column and CSV rows)")
                  if "name" in a else f"robot{i + 2}")
-        if any(b.name == aname for b in agents):
-            raise WorldError(f"two robots are named `{aname}` (the first robot is `robot`): "
-                             "give each a name of its own",
-                             span=a.value_span("name") if "name" in a else span)
-        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot, dt) if "robot" in a
-                  else robot)
+        _check_agent_name(a, aname, agents, span, unnamed)
+        if "name" not in a:
+            unnamed.add(aname)
+        if "robot" in a and a["robot"] is None:
+            raise WorldError(f"the `robot:` of `{aname}` is empty", span=a.value_span("robot"),
+                             expected="the robot keys it changes, such as "
+                                      "`robot: {max_speed: 40}`",
+                             hint=f"or leave `robot:` out: `{aname}` is then the same robot "
+                                  "as the first")
+        arobot = (read_robot(r, a["robot"], a.value_span("robot"), robot, dt,
+                             f"robot `{aname}`") if "robot" in a else robot)
         agents.append(Agent(aname, arobot,
                             read_pose(r, yamlpos.require(a, "q_init", WorldError, f"robot `{aname}`"),
                                       a.value_span("q_init"), f"q_init of `{aname}`"),
@@ -610,6 +720,28 @@ def _agents(r: _Reader, top: YMap, robot: Robot,
     agents = [replace(agent, start_span=s, goal_span=g)
               for agent, (s, g) in zip(agents, agent_spans)]
     return agents, agent_spans
+
+
+def _check_agent_name(a: YMap, aname: str, agents: list[Agent], span: Span,
+                      unnamed: set[str]) -> None:
+    """Refuse a robot's name that another robot has, or that heads the summary table's
+    column of all the robots (``all robots``); an unnamed robot is named by its place
+    (``robot3``, and ``unnamed`` holds those names), which a named one may have taken."""
+    if aname == "all robots":
+        raise WorldError("`all robots` heads the summary's column of every robot: a robot "
+                         "cannot be named so", span=a.value_span("name"),
+                         hint="name: oncoming (it heads its column and CSV rows)")
+    if not any(b.name == aname for b in agents):
+        return
+    if "name" not in a:
+        raise WorldError(f"this robot has no `name`, so it is called `{aname}`, as an earlier "
+                         f"robot is named", span=span,
+                         hint="give it a name of its own: `name: ...`")
+    first = (" (the first robot, under `robot:`, is `robot`)" if aname == "robot" else
+             f" (an earlier robot has no `name` and is called `{aname}` by its place)"
+             if aname in unnamed else "")
+    raise WorldError(f"two robots are named `{aname}`{first}: give each a name of its own",
+                     span=a.value_span("name"))
 
 
 #: the most corridor points a world may have in all: each corridor piece's walls are clipped by
@@ -1146,19 +1278,28 @@ def _box_meets(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obst
               at: tuple[float, float]) -> bool:
     """Whether obstacle ``o`` standing at ``at`` reaches into the box ``[-hl, hl] x [-hw, hw]``
     centred at ``centre`` and turned ``heading`` rad (touching is not reaching in)."""
+    return _box_gap(hl, hw, centre, heading, o, at) < 0.0
+
+
+def _box_gap(hl: float, hw: float, centre: np.ndarray, heading: float, o: Obstacle,
+             at: tuple[float, float]) -> float:
+    """The signed distance from the box of :func:`_box_meets` to obstacle ``o`` at ``at``:
+    the gap, 0 touching, minus the depth where it reaches in."""
     import math
 
     import numpy as np
 
-    from .geometry import box_polygon_depth, rect_corners
+    from .geometry import box_polygon_distance, rect_corners
 
     c, s = math.cos(heading), math.sin(heading)
     turn = np.array([[c, -s], [s, c]])                      # world -> box frame: @ turn
     if o.shape == "circle":
         x, y = (np.asarray(at, float) - centre) @ turn
-        return math.hypot(max(abs(x) - hl, 0.0), max(abs(y) - hw, 0.0)) < o.radius
+        dx, dy = abs(x) - hl, abs(y) - hw
+        inside = min(max(dx, dy), 0.0)                      # the box's signed distance
+        return math.hypot(max(dx, 0.0), max(dy, 0.0)) + inside - o.radius
     corners = rect_corners(at[0], at[1], math.radians(o.angle), o.length, o.width)
-    return bool(box_polygon_depth(hl, hw, ((corners - centre) @ turn)[None])[0] > 0.0)
+    return float(box_polygon_distance(hl, hw, ((corners - centre) @ turn)[None])[0])
 
 
 def check_starts(world: World, spans: list[Span]) -> None:
@@ -1168,8 +1309,9 @@ def check_starts(world: World, spans: list[Span]) -> None:
 
     import numpy as np
 
-    from .geometry import box_polygon_depth
+    from .geometry import box_polygon_distance
 
+    touch = " (a touch is a contact: the run would end in a collision at its first tick)"
     for i, (agent, span) in enumerate(zip(world.agents, spans)):
         st, robot = agent.start, agent.robot
         hl, hw, h = robot.length / 2, robot.width / 2, math.radians(st.heading)
@@ -1177,17 +1319,93 @@ def check_starts(world: World, spans: list[Span]) -> None:
         where = (f"at the start (q_init){_who(agent)}, ({st.x:g}, {st.y:g}) heading "
                  f"{st.heading:g} deg,")
         for o in world.obstacles:
-            if _box_meets(hl, hw, centre, h, o, (o.x, o.y)):
+            gap = _box_gap(hl, hw, centre, h, o, (o.x, o.y))
+            if gap <= 0.0:              # (touching ended the run at 0.00 s, a collision)
                 raise WorldError(f"{where} the robot's body ({robot.length:g} x "
-                                 f"{robot.width:g} in) reaches into obstacle `{o.name}`",
+                                 f"{robot.width:g} in) "
+                                 + (f"reaches into obstacle `{o.name}`" if gap < 0.0 else
+                                    f"touches obstacle `{o.name}`{touch}"),
                                  span=span, hint="move the start or the obstacle")
         c, s = math.cos(h), math.sin(h)
         for other in world.agents[:i]:
             local = (_body_corners(other) - centre) @ np.array([[c, -s], [s, c]])
-            if box_polygon_depth(hl, hw, local[None])[0] > 0.0:
-                raise WorldError(f"{where} the robot's body overlaps robot `{other.name}`'s "
-                                 "at its start", span=span,
-                                 hint="start the robots further apart")
+            gap = float(box_polygon_distance(hl, hw, local[None])[0])
+            if gap <= 0.0:
+                raise WorldError(f"{where} the robot's body "
+                                 + (f"overlaps robot `{other.name}`'s at its start" if gap < 0.0
+                                    else f"touches robot `{other.name}`'s at its start{touch}"),
+                                 span=span, hint="start the robots further apart")
+
+
+def check_goals(world: World, spans: list[Span]) -> None:
+    """Refuse two robots that cannot both stand at their goals: a robot at its goal parks
+    there, an obstacle to the others, so the run could never end in success (two goals 0 in
+    apart with tolerances of 12 and 1 in drove on to the time limit, as did a goal inside a
+    robot that starts within its own goal's tolerance and so is parked from the first
+    tick). ``spans``: each robot's goal, in the order of the world's agents."""
+    for j, b in enumerate(world.agents):
+        for i, a in enumerate(world.agents[:j]):
+            for p, q, span in ((a, b, spans[j]), (b, a, spans[i])):
+                found = _goal_taken(p, q)
+                if found:
+                    raise WorldError(found[0], span=span, hint=found[1])
+
+
+def _parks_at_start(agent: Agent) -> bool:
+    """Whether ``agent`` starts within its goal's tolerance: arrived at the first tick, it
+    stays where it starts."""
+    st, g = agent.start, agent.goal
+    return math.hypot(st.x - g.x, st.y - g.y) <= g.tolerance
+
+
+#: points on a goal's tolerance circle looked at (:func:`_goal_taken`)
+GOAL_CIRCLE = 360
+
+
+def _goal_taken(p: Agent, q: Agent) -> tuple[str, str] | None:
+    """Why ``q`` can never stand at its goal while ``p`` stands at its own, or None. A robot
+    stands at its goal with its centre anywhere within the tolerance, turned any way, so
+    only what every such pose must touch is refused: the disc of half its narrower side
+    about its centre (half its width, as :func:`_check_goal_room` keeps from walls)."""
+    import numpy as np
+
+    r = min(q.robot.length, q.robot.width) / 2
+    g, t = q.goal, q.goal.tolerance
+    if _parks_at_start(q):
+        return None                    # (parked at both starts: check_starts refused it)
+    if _parks_at_start(p):
+        # the farthest that q's centre gets from p's body: on the circle of its tolerance
+        # (the distance to a convex body is convex); between two of the points looked at
+        # it is at most pi t / GOAL_CIRCLE farther
+        st, body = p.start, p.robot
+        h = math.radians(st.heading)
+        a = np.linspace(0.0, 2 * math.pi, GOAL_CIRCLE, endpoint=False)
+        dx, dy = g.x + t * np.cos(a) - st.x, g.y + t * np.sin(a) - st.y
+        along = np.abs(dx * math.cos(h) + dy * math.sin(h)) - body.length / 2
+        across = np.abs(-dx * math.sin(h) + dy * math.cos(h)) - body.width / 2
+        far = float(np.hypot(np.maximum(along, 0.0), np.maximum(across, 0.0)).max())
+        far += math.pi * t / GOAL_CIRCLE
+        if far >= r:
+            return None
+        return (f"the goal (q_goal) of `{q.name}` at ({g.x:g}, {g.y:g}) is taken by "
+                f"`{p.name}`, which starts within its own goal's tolerance and so stands "
+                f"there from the first tick: within {t:g} in of the goal, `{q.name}`'s "
+                f"centre comes at most {far:.1f} in from `{p.name}`'s body, and its own body "
+                f"needs {r:g} in",
+                f"move the goal, or start `{p.name}` farther from its own goal")
+    rp = min(p.robot.length, p.robot.width) / 2
+    pg, tp = p.goal, p.goal.tolerance
+    apart = math.hypot(g.x - pg.x, g.y - pg.y)
+    if apart + t + tp >= r + rp:
+        return None
+    return (f"the goals (q_goal) of `{p.name}` at ({pg.x:g}, {pg.y:g}) and `{q.name}` at "
+            f"({g.x:g}, {g.y:g}) are too close for both robots to stand at them: "
+            f"{apart:.1f} in apart, with tolerances of {tp:g} and {t:g} in, the two centres "
+            f"are at most {apart + tp + t:.1f} in apart there, and the bodies need {r + rp:g} "
+            f"in (half of each one's narrower side): whichever arrives first parks in the "
+            f"other's way",
+            f"move the goals {math.ceil(r + rp - tp - t - apart - 1e-9)} in or more farther "
+            f"apart, or widen a tolerance")
 
 
 def check_jitters(world: World, written: YMap) -> None:
