@@ -1,17 +1,21 @@
-"""Robots giving way where their routes cross: randomised runs of crossroads worlds with
+"""Robots giving way where their routes cross: randomised runs of multi-robot worlds with
 every robot giving way (the default) against the same runs with none (``give_way: false``).
 
     python benchmarks/bench_traffic.py                    # 100 runs of each world, 2 workers
     python benchmarks/bench_traffic.py --runs 40 --seed 1000 --jobs 1
+    python benchmarks/bench_traffic.py --planners fuzzy,dwa --only cross135_left,tee_left_turn
 
-The worlds (``tests/data``): ``crossroads4.yaml``, four robots coming to a crossroads together,
-one from each side (each has another on its right: a ring); ``crossroads_carts.yaml``, three
-robots from three sides while two carts cross. And ``worlds/multirobot.yaml``, two robots
-head-on, where giving way should change little. For each world and each way: successes,
-collisions of a robot with a robot and with anything else (a robot's collision is with a
-robot when another robot's centre is nearer it than any cart's, within 32 in), stuck and
-timeouts, and the mean time of the successes. The peer in the same run is the world without
-giving way; the runs are the same seeds, so each row differs only by giving way.
+The worlds: ``tests/data/crossroads4.yaml``, four robots coming to a crossroads together, one
+from each side (each has another on its right: a ring); ``tests/data/crossroads_carts.yaml``,
+three robots from three sides while two carts cross; ``worlds/multirobot.yaml``, two robots
+head-on, where giving way should change little; and the layouts of ``tests/data/traffic/``
+(two robots crossing at 45, 90 and 135 deg from either side, a left turn across a lane at a
+T-junction, a merge, six robots at a crossroads, a larger robot, a fleet with one robot left
+out; each file says what it holds). For each world, planner and way: successes, collisions of
+a robot with a robot and with anything else (a robot's collision is with a robot when another
+robot's centre is nearer it than any cart's, within 32 in), stuck and timeouts, and the mean
+time of the successes. The peer in the same run is the world without giving way; the runs are
+the same seeds, so each row pair differs only by giving way.
 """
 
 from __future__ import annotations
@@ -21,18 +25,23 @@ import dataclasses
 import statistics
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from options import ROOT, guarded, positive_int
 
+from mitos_cli.errors import unknown
 from mitos_cli.sim.loop import SimResult
+from mitos_cli.sim.planner import PLANNERS, make_planner
 from mitos_cli.sim.runs import run_many
 from mitos_cli.sim.world import World
 from mitos_cli.sim.worldfile import load_world
 
-WORLDS = (ROOT / "tests" / "data" / "crossroads4.yaml",
-          ROOT / "tests" / "data" / "crossroads_carts.yaml",
-          ROOT / "worlds" / "multirobot.yaml")
+WORLDS: tuple[Path, ...] = (
+    ROOT / "tests" / "data" / "crossroads4.yaml",
+    ROOT / "tests" / "data" / "crossroads_carts.yaml",
+    ROOT / "worlds" / "multirobot.yaml",
+    *sorted((ROOT / "tests" / "data" / "traffic").glob("*.yaml")))
 #: in: a collided robot's nearest other robot (centre to centre) within this is what it met
 TOUCH = 32.0
 
@@ -75,24 +84,44 @@ def row(name: str, summaries: list[dict]) -> str:
             f"{robots} | {others} | {count['stuck']} | {count['timeout']} | {mean} |")
 
 
+def _names(text: str, what: str, known: list[str]) -> list[str]:
+    names = [p.strip() for p in text.split(",") if p.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError(f"no {what} given (comma-separated names)")
+    for name in names:
+        if name not in known:
+            err = unknown(what, name, known)
+            raise argparse.ArgumentTypeError(
+                "; ".join(x for x in (err.message, err.hint, f"expected {err.expected}") if x))
+    return names
+
+
 @guarded
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=positive_int, default=100, help="randomised runs per world")
     ap.add_argument("--seed", type=int, default=1000, help="the first run's seed")
     ap.add_argument("--jobs", type=positive_int, default=2, help="worker processes")
+    stems = [p.stem for p in WORLDS]
+    ap.add_argument("--only", type=lambda t: _names(t, "world", stems), default=stems,
+                    help="comma-separated world names (default: all)")
+    ap.add_argument("--planners", type=lambda t: _names(t, "planner", list(PLANNERS)),
+                    default=["fuzzy"], help="comma-separated (default: fuzzy)")
     args = ap.parse_args(argv)
-    print("| world, giving way | runs | success | robot-robot collisions | other collisions "
-          "| stuck | timeout | mean time of successes (s) |")
+    print("| world, planner, giving way | runs | success | robot-robot collisions | other "
+          "collisions | stuck | timeout | mean time of successes (s) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-    for path in WORLDS:
+    for path in (p for p in WORLDS if p.stem in args.only):
         world = load_world(path)
-        started = time.perf_counter()
-        for way, w in (("yes", world), ("no", without_giving_way(world))):
-            runs = run_many([w], runs=args.runs, seed=args.seed, workers=args.jobs,
-                            measure=contacts)
-            print(row(f"`{world.name}`, {way}", runs.worlds[0].summaries), flush=True)
-        print(f"({world.name}: {time.perf_counter() - started:.0f} s)", file=sys.stderr)
+        for name in args.planners:
+            started = time.perf_counter()
+            for way, w in (("yes", world), ("no", without_giving_way(world))):
+                runs = run_many([w], runs=args.runs, seed=args.seed, workers=args.jobs,
+                                planner=make_planner(name, w), measure=contacts)
+                print(row(f"`{world.name}`, {name}, {way}", runs.worlds[0].summaries),
+                      flush=True)
+            print(f"({world.name}, {name}: {time.perf_counter() - started:.0f} s)",
+                  file=sys.stderr)
     return 0
 
 

@@ -233,3 +233,42 @@ def test_a_robot_told_to_stop_where_it_gives_way_is_waiting_not_stuck(tmp_path):
         sim.step(told)
         assert sim._ways.order == {(0, 1): 1}           # the first gives way throughout
     assert not sim.done
+
+
+def test_the_echoes_of_the_robot_waited_on_are_told_apart_from_walls_and_other_robots():
+    """A robot waiting on another (``waits``) reads its echoes as that robot's: a reading
+    ending on its body, noise within :data:`ECHO_PAD` included; not one ending on a wall
+    behind it, nor on a third robot beside it, nor the readings of a robot that waits on
+    none."""
+    pose = np.array([[0.0, 0.0, 0.0], [100.0, 0.0, math.pi / 2], [100.0, 60.0, 0.0]])
+    dirs = np.array([[[1.0, 0.0], [0.0, 1.0], [100 / math.hypot(100, 60), 60 / math.hypot(100, 60)]]] * 3)
+    # robot 0's beams: along +x onto robot 1's side (its body spans x 91..109), up to a
+    # wall, and onto robot 2, standing 60 in above robot 1
+    ranges = np.array([[91.0 + 4.0, 150.0, math.hypot(100, 60) - 12.0]] * 3)
+    seen = traffic.echoes([(0, 1)], pose, [ROBOT] * 3, ranges, dirs)
+    assert seen.tolist() == [[True, False, False], [False] * 3, [False] * 3]
+    ranges[0, 0] = 91.0 - traffic.ECHO_PAD - 0.5           # short of the body: something else
+    assert not traffic.echoes([(0, 1)], pose, [ROBOT] * 3, ranges, dirs)[0, 0]
+
+
+def test_a_robot_that_waited_at_a_crossing_goes_on_without_planning_round_the_other():
+    """``cross135_left`` seed 1002: ``b`` gives way at the corner of the crossing. When it
+    marked the other robot's echoes on its map, the crossing held a trail of walls when it
+    could go: its new route swung it into the corner, and it backed out ten times and ran
+    out of time. Not marking the robot it waits on, it waits and goes straight on."""
+    res = simulate(load_world(DATA / "traffic" / "cross135_left.yaml"), seed=1002,
+                   randomise=True)
+    assert res.robot_outcomes == ("success", "success")
+    assert res.backed_out == () and res.replanned == ()
+    assert (res.speed[:, 1] < 1).any()                          # b waited
+
+
+def test_dwa_gets_going_again_after_giving_way_at_a_t_junction():
+    """``tee_left_turn`` seed 1000 with DWA: the robot turning left across the other's lane
+    waits for it; with the other's echoes marked on its map it then ended ``stuck`` (14 of
+    20 runs)."""
+    from mitos_cli.sim.planner import make_planner
+
+    world = load_world(DATA / "traffic" / "tee_left_turn.yaml")
+    res = simulate(world, make_planner("dwa", world), seed=1000, randomise=True)
+    assert res.robot_outcomes == ("success", "success")

@@ -1135,8 +1135,16 @@ class Simulation:
         if self._given.knows != "none":
             expected = self._expected[0][None] if self.n == 1 else np.stack(self._expected)
         seen = _news(s.ranges, expected, self.world.sensors.range * 0.999, self._threshold)
+        if self._ways.waits:
+            seen &= ~self._mates_echoes(s.pose, s.ranges, self._dirs)
         self._seen = list(seen)
         return seen
+
+    def _mates_echoes(self, pose: np.ndarray, ranges: np.ndarray,
+                      dirs: list[np.ndarray] | np.ndarray) -> np.ndarray:
+        """``[n, B]``: the readings that are echoes of another robot at a crossing with the
+        robot (:func:`.traffic.echoes`): news to neither its map nor its tracks."""
+        return traffic.echoes(self._ways.waits, pose, self.robots, ranges, np.asarray(dirs))
 
     def watching(self, s: _Sensed, learned: list[bool] | None = None
                  ) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
@@ -1811,6 +1819,10 @@ class Batch:
             expected = (self.got.static if self._plain else
                         np.array([e for run in self.runs for e in run._expected]))
         self._seen = seen = _news(self.got.ranges, expected, self._far, self._threshold)
+        for run, a, b in self._traffic:
+            if run._ways.waits:
+                seen[a:b] &= ~run._mates_echoes(self.pose[a:b], self.got.ranges[a:b],
+                                                self.got.dirs[a:b])
         return seen           # (no run's own: a run reads it only where it marks its map)
 
     def tracked(self, sighted: list[movers.Seen]) -> None:
