@@ -331,3 +331,15 @@ def test_a_function_of_200000_terms_is_read_in_linear_time():
                              "TERM lo := FUNCTION " + " + ".join(["a"] * 200_000) + ";")
     lo = parse_fcl(text, "f.fcl").variables["y"].term("lo")
     assert lo.params == (200_000.0, 0.0, 0.0)
+
+
+@pytest.mark.parametrize("char, name", [("\u200b", "ZERO WIDTH SPACE"),
+                                        ("\u2060", "WORD JOINER")])
+def test_a_keyword_followed_by_an_invisible_character_is_told_so(char, name):
+    """`ACT` and a zero-width space read as a name where `ACT` stands: "did you mean `ACT`?"
+    named what the user sees as written."""
+    with pytest.raises(FormatError) as got:
+        parse_fcl(BASE.replace("ACT : MIN;", f"ACT{char} : MIN;", 1), "probe.fcl")
+    assert got.value.hint == (f"`ACT` is followed by the invisible character "
+                              f"`\\u{ord(char):04x}` ({name}): delete it")
+    assert got.value.span.source_line == f"    ACT{char} : MIN;" and got.value.span.column == 5

@@ -50,6 +50,7 @@ from ..errors import (
     NoRulesError,
     Span,
     did_you_mean,
+    invisible_character,
     lines_of,
     lone_cr_as_lf,
 )
@@ -123,7 +124,11 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> FormatEr
         if exc.interactive_parser is not None:      # `expected` may hold LALR's merged states
             expected = set(exc.interactive_parser.accepts()) or expected
         keywords = set(_keywords(t.name for t in parser().terminals))
-        if exc.token.type in ("NAME", "FORMULA"):   # `END RULEBLOCK`: one word, split
+        end = exc.token.end_pos
+        hidden = invisible_character(text[end:end + 1]) if end is not None else None
+        if hidden is not None:          # (`ACT` and a zero-width space: "did you mean `ACT`?")
+            hint = f"`{shown}` is followed by the invisible character {hidden}: delete it"
+        if hint is None and exc.token.type in ("NAME", "FORMULA"):   # `END RULEBLOCK`: one word
             after = re.match(r"[ \t]+([A-Za-z_]\w*)", text[exc.token.start_pos + len(shown):]
                              if exc.token.start_pos is not None else "")
             joined = f"{shown}_{after.group(1)}".upper() if after else ""
