@@ -1142,8 +1142,8 @@ class Simulation:
 
     def _mates_echoes(self, pose: np.ndarray, ranges: np.ndarray,
                       dirs: list[np.ndarray] | np.ndarray) -> np.ndarray:
-        """``[n, B]``: the readings that are echoes of another robot at a crossing with the
-        robot (:func:`.traffic.echoes`): news to neither its map nor its tracks."""
+        """``[n, B]``: the readings of each robot that gives way that are echoes of the robot
+        it waits on (:func:`.traffic.echoes`): news to neither its map nor its tracks."""
         return traffic.echoes(self._ways.waits, pose, self.robots, ranges, np.asarray(dirs))
 
     def watching(self, s: _Sensed, learned: list[bool] | None = None

@@ -23,7 +23,9 @@ manager), and give way by the rule of the road:
   comes within the zone of the other's route and :data:`SLACK` more, measured straight to that
   route (never more than along its own, whatever a replanning does to either route); a robot
   already inside stops where it is. It goes on once the other's route, rear included, has
-  left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`).
+  left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`), and it marks
+  neither on its map nor in its tracks the echoes of the robot it waits on
+  (:func:`echoes`): the fleet shares where that robot is.
 
 It is a limit on every planner's command, as the brake is (a user's planner, DWA, a
 Gymnasium action), and it reads only what the robots share, never the world. Each run keeps
@@ -232,7 +234,9 @@ def echoes(waits: Iterable[tuple[int, int]], pose: np.ndarray, robots: Sequence[
     """``[n, B]``: which of each robot's readings (``ranges [n, B]`` along ``dirs [n, B, 2]``
     from ``pose [n, 3]``, heading in radians) are echoes of the robot it waits on (``waits``:
     pairs of a robot and the robot it gives way to): the reading ends within
-    :data:`ECHO_PAD` of that robot's body."""
+    :data:`ECHO_PAD` of that robot's body. Marked on the waiting robot's map, the robot
+    passing through the crossing was a trail of walls across it, which the waiting robot
+    planned round once it could go (into the crossing's corner, or stuck with DWA)."""
     out = np.zeros(ranges.shape, dtype=bool)
     for me, other in waits:
         x, y, h = pose[other]
