@@ -264,9 +264,15 @@ def outcome_json(outcome: Outcome, out: str) -> dict:
                 "hi": number(m.hi)}
 
     def summary(s: Summary) -> dict:
-        return {"world": s.world, "choice": s.choice.label, "runs": s.n,
-                "rates": {k: rate(v) for k, v in s.rates.items()},
-                "metrics": {k: mean(v) for k, v in s.metrics.items()}}
+        out = {"world": s.world, "choice": s.choice.label, "runs": s.n,
+               "rates": {k: rate(v) for k, v in s.rates.items()},
+               "metrics": {k: mean(v) for k, v in s.metrics.items()}}
+        if s.robots:            # a world of several robots: each one's own, under the fleet's
+            out["robots"] = [{"robot": r.robot, "runs": r.n,
+                              "rates": {k: rate(v) for k, v in r.rates.items()},
+                              "metrics": {k: mean(v) for k, v in r.metrics.items()}}
+                             for r in s.robots]
+        return out
 
     import math
 
