@@ -594,3 +594,21 @@ def test_a_rule_base_without_the_worlds_behavior_says_how_to_choose_one(tiny, tm
         "hint: the world is driven by its `behavior: drive`, which this rule base lacks: "
         "choose one of its behaviors (--behavior NAME; behavior= from Python)")
     assert not (tmp_path / "s" / "results.csv").exists()
+
+
+def test_tables_piped_are_never_cut_short(tiny, tmp_path, compare, monkeypatch):
+    """Piped or into a file, the tables were drawn 160 columns wide whatever they held: a long
+    world name or choice cut every column to `…` and dropped `n`."""
+    import shutil
+
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(tiny, "a_rather_long_world_name_for_a_study.yaml")
+    r = compare("a_rather_long_world_name_for_a_study.yaml", "--and", "lukasiewicz", "--or",
+                "probabilistic_sum", "--inference", "weighted_average", "--runs", 2, "-o", "st",
+                "-j", 1, "--no-plots")
+    assert r.exit_code == 0, r.output
+    assert "…" not in r.stdout
+    header = next(line for line in r.stdout.splitlines() if "success" in line)
+    assert header.split()[:4] == ["world", "choice", "n", "success"]
+    assert "fuzzy and=lukasiewicz or=probabilistic_sum inference=weighted_average" in r.stdout
+    assert "a_rather_long_world_name_for_a_study " in r.stdout

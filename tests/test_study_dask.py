@@ -136,3 +136,16 @@ def test_a_local_cluster_has_no_more_workers_than_tasks(monkeypatch, tmp_path):
     with pytest.raises(RuntimeError, match="stop here"):
         list(executors.run_dask(fake_sim, [object()] * 3, 500))
     assert asked == [3]
+
+
+def test_a_fleet_on_dask_equals_serial(tmp_path, client):
+    """A world of several robots: each run's robots' rows come back from the workers with it,
+    bit for bit those of a serial study, and results.csv holds the same lines."""
+    from test_study_fleet import fleet_study
+
+    serial = run_study(fleet_study(), tmp_path / "serial", workers=1)
+    dask = run_study(fleet_study(), tmp_path / "dask", executor="dask", client=client)
+    assert dask.rows == serial.rows and all(len(r["robots"]) == 2 for r in dask.rows)
+    lines = [sorted((tmp_path / d / "results.csv").read_text().splitlines())
+             for d in ("serial", "dask")]
+    assert lines[0] == lines[1] and len(lines[0]) == 1 + 2 * 3

@@ -237,9 +237,12 @@ def _print_tables(outcome: Outcome) -> None:
     from ..study.report import overlap_note, rich_tables
 
     console = Console(highlight=False, soft_wrap=False)
-    if not console.is_terminal:            # a file or a pipe: never cut the data short
-        console = Console(highlight=False, soft_wrap=False, width=160)
     table, ranking = rich_tables(outcome.summaries, outcome.ranks)
+    if not console.is_terminal:            # a file or a pipe: never cut the data short (160
+        # columns cut a study's table of long names to `…` in every column, and dropped `n`)
+        wide = Console(highlight=False, soft_wrap=False, width=1000)
+        width = max(160, *(wide.measure(t).maximum for t in (table, ranking)))
+        console = Console(highlight=False, soft_wrap=False, width=width)
     console.print(table)
     console.print(ranking)
     note = overlap_note(outcome.ranks)
@@ -261,9 +264,15 @@ def outcome_json(outcome: Outcome, out: str) -> dict:
                 "hi": number(m.hi)}
 
     def summary(s: Summary) -> dict:
-        return {"world": s.world, "choice": s.choice.label, "runs": s.n,
-                "rates": {k: rate(v) for k, v in s.rates.items()},
-                "metrics": {k: mean(v) for k, v in s.metrics.items()}}
+        out = {"world": s.world, "choice": s.choice.label, "runs": s.n,
+               "rates": {k: rate(v) for k, v in s.rates.items()},
+               "metrics": {k: mean(v) for k, v in s.metrics.items()}}
+        if s.robots:            # a world of several robots: each one's own, under the fleet's
+            out["robots"] = [{"robot": r.robot, "runs": r.n,
+                              "rates": {k: rate(v) for k, v in r.rates.items()},
+                              "metrics": {k: mean(v) for k, v in r.metrics.items()}}
+                             for r in s.robots]
+        return out
 
     import math
 

@@ -13,10 +13,15 @@ from .stats import Mean, Rate
 from .summary import ALL_WORLDS, METRICS, Rank, Summary
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from rich.table import Table
 
 RATE_COLUMNS = (("success", "success"), ("collision", "collision"), ("timeout", "timeout"),
                 ("stuck", "stuck"))
+#: the rates of a study with a world of several robots: a robot's own outcome may be `stopped`
+#: (still driving when another robot's collision or stuck ended the run; a run's is never)
+FLEET_RATE_COLUMNS = (*RATE_COLUMNS, ("stopped", "stopped"))
 TABLE_METRICS = ("time_s", "path_length_in", "min_clearance_in", "steering_total_variation_deg",
                  "replans", "backouts")
 
@@ -56,6 +61,22 @@ def _metric_heading(field: str) -> str:
     raise KeyError(field)
 
 
+def _rate_columns(summaries: list[Summary]) -> tuple[tuple[str, str], ...]:
+    """The rates the tables show: with a `stopped` column where a world has several robots."""
+    return FLEET_RATE_COLUMNS if any(s.robots for s in summaries) else RATE_COLUMNS
+
+
+def _with_robots(summaries: list[Summary]) -> list[Summary]:
+    """The tables' rows: each summary, then its robots' (indented under it, as `mitos
+    simulate --runs` shows them)."""
+    return [row for s in summaries for row in (s, *s.robots)]
+
+
+def _cell_rate(s: Summary, outcome: str, fmt: Callable[[Rate], str]) -> str:
+    """A rate's cell: ``-`` where the summary has none (a run is never `stopped`)."""
+    return fmt(s.rates[outcome]) if outcome in s.rates else "-"
+
+
 def _world_names(summaries: list[Summary]) -> dict[str, str]:
     """Each world as the tables show it: its file's stem, or its path as given where two
     worlds of the study share a stem (`corr.yaml` and `sub/corr.yaml`)."""
@@ -91,25 +112,29 @@ def rich_tables(summaries: list[Summary], ranks: list[Rank]) -> tuple[Table, Tab
     from rich import box
     from rich.table import Table
 
+    rates = _rate_columns(summaries)
+    caption = ("rates: % [Wilson 95%]; metrics: mean±std (t intervals in report.md); "
+               "* successful runs only")
+    if rates is FLEET_RATE_COLUMNS:
+        caption += ("\n" + FLEET_NOTE)
     table = Table(title="Outcomes per world and choice", title_justify="left",
-                  caption="rates: % [Wilson 95%]; metrics: mean±std (t intervals in "
-                          "report.md); * successful runs only",
-                  caption_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+                  caption=caption, caption_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
     table.add_column("world", no_wrap=True)
     table.add_column("choice", no_wrap=True)
     table.add_column("n", justify="right")
-    for _f, heading in RATE_COLUMNS:
+    for _f, heading in rates:
         table.add_column(heading, justify="right", no_wrap=True)
     for f in TABLE_METRICS:
         table.add_column(TERMINAL_HEADINGS[f], justify="right", no_wrap=True)
     last = None
     names = _world_names(summaries)
-    for s in summaries:
+    for s in _with_robots(summaries):
         world = names[s.world]
         if last is not None and world != last:
             table.add_section()
-        table.add_row(world if world != last else "", s.choice.label, str(s.n),
-                      *(_compact_rate(s.rates[f]) for f, _h in RATE_COLUMNS),
+        table.add_row(world if world != last else "",
+                      s.choice.label if s.robot is None else f"  {s.robot}", str(s.n),
+                      *(_cell_rate(s, f, _compact_rate) for f, _h in rates),
                       *(_compact_mean(s.metrics[f]) for f in TABLE_METRICS))
         last = world
     ranking = Table(title=RANK_TITLE, title_justify="left", box=box.SIMPLE_HEAD,
@@ -126,6 +151,13 @@ def rich_tables(summaries: list[Summary], ranks: list[Rank]) -> tuple[Table, Tab
                         fmt_p(r.p_value))
     return table, ranking
 
+
+#: what the rows of a world of several robots are (under the tables of a study with one)
+FLEET_NOTE = ("with several robots: a choice's row is the fleet's (a run succeeds when every "
+              "robot does, is a collision when one collides; time until the last robot "
+              "stopped, path, steering, replans and backed out summed over the robots, the "
+              "least clearance of any), and each robot's own row is under it; stopped: still "
+              "driving when another robot's collision or stuck ended the run")
 
 RANK_TITLE = ("Ranking (all worlds): success rate, then time to goal, then clearance; "
               "won/lost and McNemar p: paired runs vs the leader")
@@ -144,12 +176,13 @@ def _md_table(header: list[str], rows: list[list[str]], align: list[str]) -> str
 
 
 def outcome_table_md(summaries: list[Summary]) -> str:
-    header = ["world", "choice", "n", *(h for _f, h in RATE_COLUMNS),
+    rates = _rate_columns(summaries)
+    header = ["world", "choice", "n", *(h for _f, h in rates),
               *(_metric_heading(f) for f in TABLE_METRICS)]
     names = _world_names(summaries)
-    rows = [[names[s.world], s.choice.label, str(s.n),
-             *(fmt_rate(s.rates[f]) for f, _h in RATE_COLUMNS),
-             *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS)] for s in summaries]
+    rows = [[names[s.world], s.choice.label if s.robot is None else f"↳ {s.robot}", str(s.n),
+             *(_cell_rate(s, f, fmt_rate) for f, _h in rates),
+             *(fmt_mean(s.metrics[f]) for f in TABLE_METRICS)] for s in _with_robots(summaries)]
     return _md_table(header, rows, ["l", "l"] + ["r"] * (len(header) - 2))
 
 
@@ -201,7 +234,8 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
         "Rates with the Wilson 95% interval; metrics as mean ± std [95% t interval, cut at 0 "
         "where a metric cannot be negative]. "
         "Columns marked * use successful runs only; minimum clearance, replans and backed "
-        "out (times a robot backed out) use all runs.",
+        "out (times a robot backed out) use all runs."
+        + (" " + FLEET_MD if any(s.robots for s in summaries) else ""),
         "",
         outcome_table_md(summaries),
         "",
@@ -211,6 +245,16 @@ def render_markdown(manifest: dict, summaries: list[Summary], ranks: list[Rank],
         for title, name in images.items():
             lines += [f"![{title}]({name})", ""]
     return "\n".join(lines)
+
+
+#: what report.md says of the rows of a world of several robots
+FLEET_MD = ("In a world of several robots a choice's row is the fleet's: a run is a success "
+            "when every robot reached its goal and a collision when any robot collided; its "
+            "time is until the last robot stopped, its path length, steering TV, replans and "
+            "backed out are summed over the robots, its minimum clearance is the least of "
+            "any robot. Each robot's own outcome and figures follow in the rows marked ↳ "
+            "(`stopped`: still driving when another robot's collision or stuck ended the "
+            "run). The ranking counts the fleet's outcome.")
 
 
 def overlap_note(ranks: list[Rank]) -> str | None:

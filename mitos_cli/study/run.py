@@ -237,7 +237,8 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     with ResultStore(out_dir) as store, contextlib.ExitStack() as stack:
         if own is not None:
             stack.callback(own.close)
-        finished, todo = store.start(manifest, tasks, resume=resume)
+        finished, todo = store.start(manifest, tasks, resume=resume,
+                                     robots=_robots(fn, study.worlds))
         if on_start is not None:
             on_start(len(finished), len(tasks))
         by_index: dict[int, dict] = {}
@@ -263,6 +264,16 @@ def run_study(study: Study, out_dir: str | Path, *, executor: str = "local",
     outcome.summaries = summaries(rows, study.worlds, study.choices)
     outcome.ranks = rank(rows, outcome.pooled())
     return outcome
+
+
+def _robots(fn: TaskFn, worlds: list[str]) -> dict[str, tuple[str, ...]]:
+    """Each world of several robots and their names, as the task function (the simulator's:
+    :meth:`.Simulator.robots`) tells them; none from one that does not."""
+    robots = getattr(fn, "robots", None)
+    if robots is None:
+        return {}
+    found = {world: tuple(robots(world)) for world in worlds}
+    return {world: names for world, names in found.items() if names}
 
 
 class Clocks:

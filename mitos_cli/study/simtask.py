@@ -201,7 +201,16 @@ def run_tasks(context: StudyContext, tasks: Sequence[Task],
 
 
 def _fields(result: SimResult) -> dict:
-    return {"outcome": result.outcome, **{f: result.metrics[f] for f in RESULT_FIELDS[1:]}}
+    """The run's figures over all robots; with several, each robot's under ``robots``: its
+    own outcome and figures as ``mitos simulate`` gives them (:attr:`.SimResult.robot_metrics`;
+    its collisions 1 where it collided), without ticks (the run's)."""
+    out = {"outcome": result.outcome, **{f: result.metrics[f] for f in RESULT_FIELDS[1:]}}
+    if len(result.robot_metrics) > 1:
+        out["robots"] = [{"robot": m["name"], "outcome": m["outcome"],
+                          "collisions": int(m["outcome"] == "collision"),
+                          **{f: m[f] for f in RESULT_FIELDS[2:] if f != "ticks"}}
+                         for m in result.robot_metrics]
+    return out
 
 
 @dataclass(frozen=True)
@@ -218,6 +227,12 @@ class Simulator:
         from ..sim.runs import CLOCK_EVERY
 
         return run_tasks(self.context, tasks, every=CLOCK_EVERY)
+
+    def robots(self, path: str) -> tuple[str, ...]:
+        """The names of the robots of the world ``path`` where it has several (``()``: one),
+        whose runs have a row per robot in ``results.csv``."""
+        agents = _world(path, _world_key(self.context, path)).agents
+        return tuple(a.name for a in agents) if len(agents) > 1 else ()
 
     def worlds(self, tasks: Sequence[Task]) -> list[World]:
         """The worlds ``tasks`` run, as the workers read them: what a default number of

@@ -44,7 +44,15 @@ COLUMNS = (*KEY_FIELDS, "seed", *RESULT_FIELDS)
 #: the columns of results.csv before it had ``replans`` and ``backouts`` (its rows cannot be
 #: resumed: they lack figures every row of the study's report must have)
 COLUMNS_BEFORE_REPLANS = COLUMNS[:-2]
+#: the columns of a study with a world of several robots: each run of such a world has a row
+#: per robot (``robot``: its name), then the run's own row (``robot`` empty: the fleet's
+#: figures, as every run of a one-robot world has); ``ticks`` is the run's, empty in a
+#: robot's row
+FLEET_COLUMNS = (*KEY_FIELDS, "robot", "seed", *RESULT_FIELDS)
 OUTCOMES = ("success", "collision", "timeout", "stuck")
+#: a robot's own outcome may also be ``stopped``: still driving when another robot's collision
+#: or stuck ended the run (``sim.loop.ROBOT_OUTCOMES``, which the simulator's import brings)
+ROBOT_OUTCOMES = (*OUTCOMES, "stopped")
 #: the fields no run reports below 0 (counts, a time, a length, a speed, a variation, the run's
 #: index and seed; a clearance is below 0 where a robot overlaps what it hit)
 NON_NEGATIVE = frozenset({"collisions", "time_s", "path_length_in", "mean_speed_in_s",
@@ -66,12 +74,17 @@ class StudyError(MitosError):
 
 
 def row_of(task: Task, result: dict) -> dict:
-    """The CSV row of a finished task: its key, its seed and the simulator's result."""
+    """The CSV row of a finished task: its key, its seed and the simulator's result; with
+    several robots, each robot's figures under ``robots`` (``robot``: its name; no ``ticks``),
+    as :meth:`.SimResult.summary` gives them."""
     c = task.choice
     row = {"world": task.world, "planner": c.planner, "and": c.and_, "or": c.or_,
            "inference": c.inference, "run": task.run, "seed": task.seed}
     for f in RESULT_FIELDS:
         row[f] = result[f]
+    if result.get("robots"):
+        row["robots"] = [{"robot": r["robot"], **{f: r.get(f) for f in RESULT_FIELDS}}
+                         for r in result["robots"]]
     return row
 
 
@@ -80,26 +93,29 @@ def key_of(row: dict) -> tuple[str, ...]:
 
 
 def _format(value: object) -> str:
+    if value is None:               # (a robot's ticks: the run's row holds them)
+        return ""
     if isinstance(value, float):
         return repr(value)          # shortest string that reads back to the same double
     return str(value)
 
 
-def _expected(field: str) -> str:
-    """What a field of a row must be."""
+def _expected(field: str, outcomes: tuple[str, ...] = OUTCOMES) -> str:
+    """What a field of a row must be (``outcomes``: a run's, or a robot's)."""
     if field == "outcome":
-        return "one of " + ", ".join(OUTCOMES)
+        return "one of " + ", ".join(outcomes)
     kind = "a whole number" if field in INT_FIELDS else "a finite number"
     return kind + (", 0 or more" if field in NON_NEGATIVE else "")
 
 
-def _wrong(field: str, value: Any) -> str | None:     # as parsed: the field decides str, int or float
+def _wrong(field: str, value: Any,       # as parsed: the field decides str, int or float
+           outcomes: tuple[str, ...] = OUTCOMES) -> str | None:
     """What is wrong with a row's parsed ``value`` of ``field`` (``None``: did not parse),
-    or ``None`` when nothing is."""
+    or ``None`` when nothing is (``outcomes``: a run's, or a robot's)."""
     if value is None:
         return "not a number"
-    if field == "outcome" and value not in OUTCOMES:
-        return "not an outcome of a run"
+    if field == "outcome" and value not in outcomes:
+        return "not an outcome of a " + ("run" if outcomes == OUTCOMES else "robot")
     if field in FLOAT_FIELDS and not math.isfinite(value):
         return "which no run reports"
     if field in RESULT_FIELDS and field != "outcome" and abs(value) > LARGEST_FIGURE:
@@ -137,15 +153,20 @@ class ResultStore:
         self._names: dict[str, str] = {}   # a world as given now -> as the rows name it
         self._manifest_text = ""           # study.json as :meth:`manifest` read it last
         self._held: int | None = None      # the directory, locked while a study runs in it
+        self.columns: tuple[str, ...] = COLUMNS    # the file's (:data:`FLEET_COLUMNS`: a row
+                                                   # per robot)
 
     # -- reading -----------------------------------------------------------------------------
 
     def load(self) -> list[dict]:
-        """The finished rows. Reading never writes: a last line without its newline is a row
+        """The finished rows, one per run (a run of several robots with its robots' rows
+        under ``robots``). Reading never writes: a last line without its newline is a row
         when it is a whole one (an editor saves a file so), and is left out when it was cut
-        short (a kill in the middle of a row); :meth:`start` mends the file only once the
+        short (a kill in the middle of a row), and so are the robots' rows of a run whose own
+        row, written after them, is not there; :meth:`start` mends the file only once the
         study goes on."""
         self._keep, self._unended = None, False
+        self.columns = COLUMNS
         if not self.path.exists():
             return []
         _refuse_special(self.path, "results file")
@@ -157,7 +178,7 @@ class ResultStore:
             raise StudyError(unreadable("results file", self.path, exc), span=bad_byte(
                 self.path, exc), hint=f"choose another output directory with -o, or remove "
                                       f"{self.path} to run the study again") from None
-        last = _whole_line(data[cut:], header=cut == 0)
+        last = _whole_line(data[cut:], text.partition("\n")[0].rstrip("\r") if cut else None)
         if last is not None:
             text, self._unended = text + last + "\n", True
         elif cut < len(data):                              # killed in the middle of a row
@@ -173,15 +194,34 @@ class ResultStore:
                                  f"rows have no replans and backouts, which this version "
                                  f"reports for every run", span=top,
                                  hint="run the study again in another directory with -o")
-            if tuple(header) != COLUMNS:
+            if tuple(header) not in (COLUMNS, FLEET_COLUMNS):
                 raise StudyError(f"{self.path} is not a results file of this version of mitos",
-                                 span=top, expected="the columns " + ",".join(COLUMNS),
+                                 span=top, expected="the columns " + ",".join(COLUMNS)
+                                 + " (with `robot` after `run` in a study of several robots)",
                                  hint="choose another output directory with -o")
+            self.columns = tuple(header)
             lines, rows, self._at = text.splitlines(), [], []
+            robots: list[tuple[dict, tuple[int, str, list[str]]]] = []   # before their run's
+            ended = reader.line_num                        # the line the last run's rows end on
             for values in reader:
                 line_no = reader.line_num                  # (a row's last line)
-                rows.append(self._row(values, line_no, lines[line_no - 1]))
-                self._at.append((line_no, lines[line_no - 1], values))
+                at = (line_no, lines[line_no - 1], values)
+                row = self._row(*at)
+                name = row.pop("robot", "")
+                if robots and key_of(robots[0][0]) != key_of(row):
+                    self._orphans(robots)
+                if name:
+                    self._robot_once(robots, row, name, at)
+                    robots.append(({**row, "robot": name}, at))
+                    continue
+                if robots:
+                    row["robots"] = self._robots_of(row, at, robots)
+                    robots = []
+                rows.append(row)
+                self._at.append(at)
+                ended = line_no
+            if robots:       # a run's robots without the run's own row: killed as they were
+                self._keep, self._unended = _line_end(data, ended), False      # written
             self._refuse_twice(rows)
             return rows
         except csv.Error as exc:               # a field past csv's limit
@@ -191,38 +231,89 @@ class ResultStore:
                              span=Span(str(self.path), line_no, 1, line[:200]),
                              hint="the file was edited by hand; remove that line") from None
 
-    def _row(self, values: list[str], line_no: int, line: str) -> dict:
-        """Line ``line_no``'s ``values`` as a row, checked: what a run can report (a known
-        outcome, whole numbers, finite figures, no count, time or length below 0, a collision
-        counted where the outcome is one), so that a row edited by hand cannot count as a run
-        it is not (a misspelt outcome in no column, a ``nan`` left out of a mean, a time of
-        -5 s in one)."""
-        if len(values) != len(COLUMNS):
-            raise StudyError(f"expected {len(COLUMNS)} values in a row, found {len(values)}",
+    def _row(self, line_no: int, line: str, values: list[str]) -> dict:
+        """Line ``line_no``'s ``values`` as a row, checked: what a run (or a robot of it) can
+        report (a known outcome, whole numbers, finite figures, no count, time or length below
+        0, a collision counted where the outcome is one), so that a row edited by hand cannot
+        count as a run it is not (a misspelt outcome in no column, a ``nan`` left out of a
+        mean, a time of -5 s in one)."""
+        columns = self.columns
+        if len(values) != len(columns):
+            raise StudyError(f"expected {len(columns)} values in a row, found {len(values)}",
                              span=Span(str(self.path), line_no, 1, line[:200]),
                              hint="the file was edited by hand; remove that line")
+        robot = "robot" in columns and values[columns.index("robot")] != ""
+        outcomes = ROBOT_OUTCOMES if robot else OUTCOMES
         row: dict = {}                # each field's value as its kind parses it
-        for j, (f, v) in enumerate(zip(COLUMNS, values)):
+        for j, (f, v) in enumerate(zip(columns, values)):
+            if robot and f == "ticks":          # (the run's row holds them)
+                row[f] = None
+                if v != "":
+                    raise StudyError(f"`ticks` is `{v:.40}` in the row of robot "
+                                     f"`{values[columns.index('robot')]:.40}`",
+                                     span=self._span(line_no, line, values, j),
+                                     expected="empty: a run's ticks are in its own row",
+                                     hint="the file was edited by hand; remove that line")
+                continue
             try:
                 row[f] = value = _parse(f, v)
             except ValueError:
                 value = None
-            bad = _wrong(f, value)
+            bad = _wrong(f, value, outcomes)
             if bad:
-                hint = did_you_mean(v, OUTCOMES) if f == "outcome" else None
+                hint = did_you_mean(v, outcomes) if f == "outcome" else None
                 raise StudyError(f"`{f}` is `{v:.40}`, {bad}",
                                  span=self._span(line_no, line, values, j),
-                                 expected=_expected(f) + (f", within ±{LARGEST_FIGURE:g}"
-                                                          if bad == TOO_LARGE else ""),
+                                 expected=_expected(f, outcomes) + (
+                                     f", within ±{LARGEST_FIGURE:g}" if bad == TOO_LARGE else ""),
                                  hint=hint or "the file was edited by hand; remove that line")
-        if (row["outcome"] == "collision") != (row["collisions"] > 0):
-            j = COLUMNS.index("collisions")
+        if (row["outcome"] == "collision") != (row["collisions"] > 0) or (
+                robot and row["collisions"] > 1):
+            j = columns.index("collisions")
             raise StudyError(f"`collisions` is `{values[j]}` in a row whose outcome is "
                              f"`{row['outcome']}`", span=self._span(line_no, line, values, j),
-                             expected="1 or more where the outcome is `collision`, else 0 (a "
-                                      "run's outcome is `collision` when a robot collided)",
+                             expected=("1 where the robot's outcome is `collision`, else 0"
+                                       if robot else "1 or more where the outcome is "
+                                       "`collision`, else 0 (a run's outcome is `collision` "
+                                       "when a robot collided)"),
                              hint="the file was edited by hand; remove that line")
         return row
+
+    def _robot_once(self, robots: list, row: dict, name: str,
+                    at: tuple[int, str, list[str]]) -> None:
+        """A robot's row for a run whose rows already hold one of that robot: refused."""
+        for held, (line_no, _, _) in robots:
+            if held["robot"] == name:
+                raise StudyError(
+                    f"robot `{name}` of run {row['run']} of {Path(row['world']).name} "
+                    f"({_label(row)}) is here a second time: its first row is line {line_no}",
+                    span=self._span(at[0], at[1], at[2], self.columns.index("robot")),
+                    hint="the file was edited by hand; remove one of the two lines")
+
+    def _orphans(self, robots: list) -> None:
+        """Robots' rows followed by another run's rows, not their own run's: a run's rows
+        are written together, its own last, so only a hand edit leaves them."""
+        first, (line_no, line, values) = robots[0]
+        raise StudyError(
+            f"the row of robot `{first['robot']}` of run {first['run']} of "
+            f"{Path(first['world']).name} ({_label(first)}) is not followed by its run's row "
+            f"(`robot` empty), which ends a run's rows",
+            span=self._span(line_no, line, values, self.columns.index("robot")),
+            hint="the file was edited by hand; remove the robots' rows of that run")
+
+    def _robots_of(self, row: dict, at: tuple[int, str, list[str]],
+                   robots: list) -> list[dict]:
+        """The robots' rows of run ``row`` (at ``at``), as :func:`row_of` gives them; its
+        ``collisions`` must count its robots' (the simulator's do)."""
+        out = [{"robot": r["robot"], **{f: r[f] for f in RESULT_FIELDS}} for r, _ in robots]
+        crashed = sum(r["outcome"] == "collision" for r in out)
+        if row["collisions"] != crashed:
+            raise StudyError(f"`collisions` is `{row['collisions']}` in a run whose robots' "
+                             f"rows hold {plural(crashed, 'collision')}",
+                             span=self._span(*at, self.columns.index("collisions")),
+                             expected="the robots' collisions, counted",
+                             hint="the file was edited by hand; remove that run's lines")
+        return out
 
     def _refuse_twice(self, rows: list[dict]) -> None:
         """A run held twice (a row copied, two results files joined): the study would count
@@ -317,10 +408,12 @@ class ResultStore:
 
     # -- writing -----------------------------------------------------------------------------
 
-    def start(self, manifest: dict, tasks: list[Task], *,
-              resume: bool) -> tuple[list[dict], list[Task]]:
+    def start(self, manifest: dict, tasks: list[Task], *, resume: bool,
+              robots: dict[str, tuple[str, ...]] | None = None) -> tuple[list[dict], list[Task]]:
         """Open the directory for a study of ``tasks``: the rows already finished (with
-        ``resume``, in task order) and the tasks still to run.
+        ``resume``, in task order) and the tasks still to run. ``robots``: each world of the
+        study (as given) that has several robots, and their names: its runs have a row per
+        robot (:data:`FLEET_COLUMNS`; a study without one writes :data:`COLUMNS`, as before).
 
         Without ``resume`` an existing ``results.csv`` with rows is an error rather than being
         overwritten; with it, the directory must hold a study (its ``study.json`` or
@@ -371,7 +464,7 @@ class ResultStore:
                              f"{exc.strerror or exc}") from None
         self._hold()
         _refuse_special(self.manifest_path, "study manifest")   # (written to below)
-        rows = self.load()
+        rows = loaded = self.load()
         if rows and not resume:
             raise StudyError(f"{self.path} already holds {plural(len(rows), 'result')}",
                              hint="pass --resume to continue that study, or choose another "
@@ -393,14 +486,65 @@ class ResultStore:
             line_no, line, values = self._at[at[0]]
             _refuse_narrower([rows[i] for i in at], old or {}, self.path, self.dir, given,
                              self._span(line_no, line, values, 0, len(KEY_FIELDS) - 1))
+        robots = dict(robots or {})
+        widen = bool(rows and robots) and self.columns == COLUMNS
+        self._check_robots(rows, robots, widen)
         write_atomic(self.manifest_path, json.dumps(manifest, indent=2) + "\n")
-        if not rows:
-            write_atomic(self.path, ",".join(COLUMNS) + "\n")
+        if not rows or widen:      # (a file of one robot's runs, widened: its rows as they were)
+            self.columns = FLEET_COLUMNS if robots else COLUMNS
+            write_atomic(self.path, ",".join(self.columns) + "\n"
+                         + "".join(self._lines(r, named=True) for r in (loaded if widen else [])))
         else:
             self._mend()
         # kept open across append() calls (one fsync'd line per finished run); close() closes it
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return finished, todo
+
+    def _check_robots(self, rows: list[dict], robots: dict[str, tuple[str, ...]],
+                      widen: bool) -> None:
+        """Every run of ``rows`` (their worlds named as given now) has a row for each robot
+        of its world (``robots``), as the study writes them, and no others. A file written
+        before `compare` wrote a row per robot (``widen``: no ``robot`` column, and the study
+        has a world of several robots) may go on only where it holds no run of such a world:
+        its rows are then written again with the column, empty."""
+        for row, (line_no, line, values) in zip(rows, self._at):
+            want, world = robots.get(row["world"], ()), Path(row["world"]).name
+            if widen and want:
+                raise StudyError(
+                    f"{self.path} was written before `mitos compare` wrote a row per robot: "
+                    f"its runs of {world} have none, which this version writes for each run of "
+                    f"a world of several robots", span=Span(str(self.path), line_no, 1,
+                                                            line[:200]),
+                    hint="run the study again in another directory with -o")
+            names = tuple(r["robot"] for r in row.get("robots", ()))
+            if names != want:
+                said = ", ".join(f"`{n}`" for n in names) or "no robot"
+                raise StudyError(
+                    f"run {row['run']} of {world} ({_label(row)}) has rows of {said}, where the "
+                    f"world's robots are " + (", ".join(f"`{n}`" for n in want) or "one, with "
+                                              "no row of its own"),
+                    span=self._span(line_no, line, values, 0, len(KEY_FIELDS) - 1),
+                    hint="the file was edited by hand; remove that run's lines, or choose "
+                         "another directory with -o")
+
+    def _lines(self, row: dict, named: bool = False) -> str:
+        """The lines of a finished run (:func:`row_of`'s ``row``): its robots' rows, then its
+        own, which ends them (written together, so that a kill leaves no run's own row
+        without its robots'); ``named``: its world is named as the rows name it already."""
+        if not named and row["world"] in self._names:
+            row = {**row, "world": self._names[row["world"]]}
+        out = io.StringIO()
+        writer = csv.writer(out, lineterminator="\n")
+        if "robot" not in self.columns:
+            if row.get("robots"):           # (start() chose the columns from the worlds)
+                raise RuntimeError("ResultStore: a run of several robots in a results file "
+                                   "without a `robot` column")
+            writer.writerow(_format(row[f]) for f in self.columns)
+            return out.getvalue()
+        for robot in row.get("robots", ()):
+            writer.writerow(_format({**row, **robot}[f]) for f in self.columns)
+        writer.writerow(_format({**row, "robot": ""}[f]) for f in self.columns)
+        return out.getvalue()
 
     def _hold(self) -> None:
         """Lock the directory for this study until :meth:`close` (or the process's end, a
@@ -438,15 +582,11 @@ class ResultStore:
                 fh.write(b"\n")
 
     def append(self, row: dict) -> None:
-        """Write one finished row and make it durable before returning (its world named as
-        the rows before it name it)."""
-        if row["world"] in self._names:
-            row = {**row, "world": self._names[row["world"]]}
-        line = io.StringIO()
-        csv.writer(line, lineterminator="\n").writerow(_format(row[f]) for f in COLUMNS)
+        """Write one finished run's rows (:meth:`_lines`) and make them durable before
+        returning (its world named as the rows before it name it)."""
         if self._file is None:
             raise RuntimeError("ResultStore.append before open")   # a programming error
-        self._file.write(line.getvalue())
+        self._file.write(self._lines(row))
         self._file.flush()
         os.fsync(self._file.fileno())
 
@@ -474,26 +614,36 @@ def _refuse_special(path: Path, kind: str) -> None:
                          hint=f"choose another output directory with -o, or remove {path}")
 
 
-def _whole_line(data: bytes, header: bool) -> str | None:
+def _whole_line(data: bytes, header: str | None) -> str | None:
     """The last line of a results file, without its newline, as text if it is whole: the
-    ``header``, or a row with at least the values of a row, the last not empty (a kill cuts a
-    row short, never makes it longer); ``None`` when it was cut short or there is none."""
+    header (``header`` None: the file holds no other line), or a row with at least the values
+    of a row under ``header``, the last not empty (a kill cuts a row short, never makes it
+    longer); ``None`` when it was cut short or there is none."""
     try:
-        line = data.decode("utf-8-sig" if header else "utf-8")
+        line = data.decode("utf-8-sig" if header is None else "utf-8")
     except UnicodeDecodeError:
         return None                                   # cut inside a character
     if not line:
         return None
-    if header:
-        full = ",".join(COLUMNS)
-        return None if full.startswith(line) and line != full else line
+    if header is None:
+        whole = (",".join(COLUMNS), ",".join(FLEET_COLUMNS))
+        return line if line in whole or not any(w.startswith(line) for w in whole) else None
     try:
         values = next(csv.reader([line]))
     except (csv.Error, StopIteration):
         return None
-    if len(values) > len(COLUMNS) or (len(values) == len(COLUMNS) and values[-1]):
+    width = len(FLEET_COLUMNS) if header == ",".join(FLEET_COLUMNS) else len(COLUMNS)
+    if len(values) > width or (len(values) == width and values[-1]):
         return line
     return None
+
+
+def _line_end(data: bytes, line_no: int) -> int:
+    """Where line ``line_no`` of ``data`` ends, its newline included."""
+    at = 0
+    for _ in range(line_no):
+        at = data.index(b"\n", at) + 1
+    return at
 
 
 def write_atomic(path: Path, text: str) -> None:

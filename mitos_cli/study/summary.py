@@ -21,12 +21,12 @@ McNemar test (two-sided), which says whether the difference in success could be 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..words import plural
 from .spec import Choice
 from .stats import Mean, Rate, mean_interval, wilson
-from .store import OUTCOMES
+from .store import OUTCOMES, ROBOT_OUTCOMES
 
 ALL_WORLDS = "all worlds"
 
@@ -51,13 +51,17 @@ NOT_NEGATIVE = frozenset({"time_s", "path_length_in", "steering_total_variation_
 
 @dataclass(frozen=True)
 class Summary:
-    """The figures of one choice in one world (or pooled over all worlds)."""
+    """The figures of one choice in one world (or pooled over all worlds); in a world of
+    several robots, the fleet's (a run's outcome and figures over all its robots), with each
+    robot's own under :attr:`robots` (``robot``: its name; its rates also of ``stopped``)."""
 
     world: str
     choice: Choice
     n: int
     rates: dict[str, Rate]
     metrics: dict[str, Mean]
+    robot: str | None = None
+    robots: tuple[Summary, ...] = ()
 
     def __repr__(self) -> str:   # the generated one spelt out every rate and mean (1,100 chars)
         ok = self.rates.get("success")
@@ -65,8 +69,10 @@ class Summary:
                 if ok is not None and ok.n else "")
         time = self.metrics.get("time_s")
         timed = f", time to goal {time.mean:.3g} s" if time is not None and time.mean is not None else ""
-        return (f"<Summary {self.world!r}, {self.choice.label}: {plural(self.n, 'run')}"
-                f"{rate}{timed}>")
+        who = f", robot {self.robot!r}" if self.robot is not None else ""
+        fleet = f", {plural(len(self.robots), 'robot')}" if self.robots else ""
+        return (f"<Summary {self.world!r}{who}, {self.choice.label}: {plural(self.n, 'run')}"
+                f"{rate}{timed}{fleet}>")
 
 
 @dataclass(frozen=True)
@@ -90,18 +96,29 @@ def choice_of(row: dict) -> Choice:
     return Choice(row["planner"], row["and"], row["or"], row["inference"])
 
 
-def summarize(world: str, choice: Choice, rows: list[dict]) -> Summary:
+def summarize(world: str, choice: Choice, rows: list[dict], robot: str | None = None) -> Summary:
+    """The summary of ``rows``: runs, or (``robot``: its name) one robot's rows of them,
+    whose rates are also of ``stopped``; a run's rows with their robots' under ``robots``
+    give the fleet's summary with each robot's."""
     n = len(rows)
-    rates = {o: wilson(sum(r["outcome"] == o for r in rows), n) for o in OUTCOMES}
+    outcomes = OUTCOMES if robot is None else ROBOT_OUTCOMES
+    rates = {o: wilson(sum(r["outcome"] == o for r in rows), n) for o in outcomes}
     ok = [r for r in rows if r["outcome"] == "success"]
     metrics = {f: mean_interval((r[f] for r in (ok if which == "success" else rows)),
                                 floor=0.0 if f in NOT_NEGATIVE else None)
                for f, _label, _unit, which in METRICS}
-    return Summary(world, choice, n, rates, metrics)
+    out = Summary(world, choice, n, rates, metrics, robot)
+    names = list(dict.fromkeys(x["robot"] for r in rows for x in r.get("robots", ())))
+    if robot is None and names:
+        out = replace(out, robots=tuple(
+            summarize(world, choice, [x for r in rows for x in r.get("robots", ())
+                                      if x["robot"] == name], name) for name in names))
+    return out
 
 
 def summaries(rows: list[dict], worlds: list[str], choices: list[Choice]) -> list[Summary]:
-    """One summary per (world, choice) in study order, then one per choice over all worlds."""
+    """One summary per (world, choice) in study order (in a world of several robots, with
+    each robot's), then one per choice over all worlds (the fleets' runs, without robots)."""
     groups: dict[tuple[str, Choice], list[dict]] = {}
     for r in rows:
         groups.setdefault((r["world"], choice_of(r)), []).append(r)
@@ -109,7 +126,7 @@ def summaries(rows: list[dict], worlds: list[str], choices: list[Choice]) -> lis
     if len(worlds) > 1:
         for c in choices:
             pooled = [r for w in worlds for r in groups.get((w, c), [])]
-            out.append(summarize(ALL_WORLDS, c, pooled))
+            out.append(replace(summarize(ALL_WORLDS, c, pooled), robots=()))
     return out
 
 
