@@ -558,6 +558,30 @@ def test_tsukamoto_inverses_at_both_infinities_give_the_default_and_say_so(tmp_p
         evaluate(c, np.array([[0.0]]))
 
 
+def test_a_batch_says_which_rows_the_rules_fire_in_but_give_no_value(tmp_path, capsys):
+    """`--batch` said "no rule sets `y` in 1 row of 3" of a row where both rules fire fully
+    (x = 0: inverses at +inf and -inf); x = 10 is a row no rule sets."""
+    from mitos_cli.cli.app import main
+
+    path = tmp_path / "t.fll"
+    path.write_text(OPPOSITE_SIGMOIDS.replace("Triangle 0 0 10", "Triangle 0 0 9"),
+                    encoding="utf-8")
+    (tmp_path / "b.csv").write_text("x\n0\n1\n10\n", encoding="utf-8")
+    with pytest.raises(SystemExit) as done:
+        main(["eval", str(path), "--batch", str(tmp_path / "b.csv")])
+    captured = capsys.readouterr()
+    assert done.value.code == 0
+    assert ("no rule sets `y` in 1 row of 3, and the rules that fire give it no value in 1 "
+            "other: the file's default (0.5) is written there") in captured.err
+    assert captured.out.splitlines()[1] == "0,0.5"
+    path.write_text(OPPOSITE_SIGMOIDS.replace("  default: 0.5\n", ""), encoding="utf-8")
+    with pytest.raises(SystemExit) as done:
+        main(["eval", str(path), "--batch", str(tmp_path / "b.csv")])
+    err = capsys.readouterr().err
+    assert done.value.code == 1
+    assert "b.csv:2:1: no output value: the rules that fire give `y` no value for x=0" in err
+
+
 def test_tsukamoto_refuses_a_term_concluded_twice():
     from mitos_cli.errors import RuleBaseError
 
