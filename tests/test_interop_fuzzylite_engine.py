@@ -506,6 +506,82 @@ def test_fll_writer_refuses_a_tsukamoto_term_without_inverse_at_the_term(tmp_pat
     assert not (tmp_path / "t.fll").exists()
 
 
+OPPOSITE_SIGMOIDS = """\
+Engine: opposite
+InputVariable: x
+  range: 0 10
+  term: low Triangle 0 0 10
+  term: also_low Triangle 0 0 5
+OutputVariable: y
+  range: 0 1
+  aggregation: none
+  defuzzifier: WeightedAverage Tsukamoto
+  default: 0.5
+  term: down Sigmoid 0.5 -30
+  term: up Sigmoid 0.5 30
+RuleBlock: b
+  conjunction: Minimum
+  activation: General
+  rule: if x is low then y is down
+  rule: if x is also_low then y is up
+"""
+
+
+def test_tsukamoto_inverses_at_both_infinities_give_the_default_and_say_so(tmp_path, capsys):
+    """At x = 0 both rules fire fully: `down` reaches 1 at -inf and `up` at +inf, and their
+    weighted average has no value. NumPy's "invalid value encountered in add" reached the
+    terminal, `mitos eval` printed the declared default as the rules' value (`y = 0.5`, no
+    note) and `--json` did not list it as defaulted; without a default the error blamed a
+    hedged consequent's underflow."""
+    import json
+    import warnings
+
+    from mitos_cli.cli.app import main
+    from mitos_cli.errors import EmptyOutputError
+
+    path = tmp_path / "t.fll"
+    path.write_text(OPPOSITE_SIGMOIDS, encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert run(OPPOSITE_SIGMOIDS, [[0.0]])[0, 0] == 0.5
+        main_out = []
+        for argv in (["eval", str(path), "x=0"], ["eval", str(path), "x=0", "--json"]):
+            with pytest.raises(SystemExit) as done:
+                main(argv)
+            captured = capsys.readouterr()
+            assert done.value.code == 0 and "RuntimeWarning" not in captured.err
+            main_out.append(captured.out)
+    assert "y = 0.5   (its default: the rules that fire give it no value here)" in main_out[0]
+    assert json.loads(main_out[1])["defaulted"] == ["y"]
+    c = compile_rulebase(parse_fll(OPPOSITE_SIGMOIDS.replace("  default: 0.5\n", ""), "t.fll"))
+    with pytest.raises(EmptyOutputError, match=r"lie at \+inf and -inf .* no value"):
+        evaluate(c, np.array([[0.0]]))
+
+
+def test_a_batch_says_which_rows_the_rules_fire_in_but_give_no_value(tmp_path, capsys):
+    """`--batch` said "no rule sets `y` in 1 row of 3" of a row where both rules fire fully
+    (x = 0: inverses at +inf and -inf); x = 10 is a row no rule sets."""
+    from mitos_cli.cli.app import main
+
+    path = tmp_path / "t.fll"
+    path.write_text(OPPOSITE_SIGMOIDS.replace("Triangle 0 0 10", "Triangle 0 0 9"),
+                    encoding="utf-8")
+    (tmp_path / "b.csv").write_text("x\n0\n1\n10\n", encoding="utf-8")
+    with pytest.raises(SystemExit) as done:
+        main(["eval", str(path), "--batch", str(tmp_path / "b.csv")])
+    captured = capsys.readouterr()
+    assert done.value.code == 0
+    assert ("no rule sets `y` in 1 row of 3, and the rules that fire give it no value in 1 "
+            "other: the file's default (0.5) is written there") in captured.err
+    assert captured.out.splitlines()[1] == "0,0.5"
+    path.write_text(OPPOSITE_SIGMOIDS.replace("  default: 0.5\n", ""), encoding="utf-8")
+    with pytest.raises(SystemExit) as done:
+        main(["eval", str(path), "--batch", str(tmp_path / "b.csv")])
+    err = capsys.readouterr().err
+    assert done.value.code == 1
+    assert "b.csv:2:1: no output value: the rules that fire give `y` no value for x=0" in err
+
+
 def test_tsukamoto_refuses_a_term_concluded_twice():
     from mitos_cli.errors import RuleBaseError
 

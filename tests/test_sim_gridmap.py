@@ -40,6 +40,12 @@ def test_an_ascii_pgm_with_comments_in_its_raster_reads_as_map_server_reads_it()
         parse_pgm(b"P2 2 3 255 254 254 x 205 0 0")
 
 
+def test_a_comment_after_an_ascii_pgms_maximum_value_is_skipped_as_in_its_raster():
+    """Only a binary PGM's pixels start at the byte after the maximum value."""
+    px, _ = parse_pgm(b"P2\n2 1\n255# made by hand\n0 255\n")
+    assert px.tolist() == [[0, 255]]
+
+
 def test_sixteen_bit_pgm():
     px, maxval = parse_pgm(b"P5 1 2 65535\n" + bytes([0xFF, 0xFF, 0x00, 0x01]))
     assert maxval == 65535 and px.ravel().tolist() == [65535, 1]
@@ -72,6 +78,12 @@ def test_a_binary_pgm_whose_header_ends_in_cr_lf_is_refused_not_shifted():
     (b"P5 2 1 100\n\x00\xfe", r"column 2, row 1 \(counted from 1 at the top left\) is 254, "
                                  "outside 0..100"),
     (b"P5\n" + b"9" * 5000 + b" 1\n255\n\x00", "a number of 5,000 digits"),
+    # the byte after the maximum value was skipped whatever it was: a comment's text became
+    # the first pixels (here 0x63 `c`, 0x0A), the map shifted; nothing there, "holds -1"
+    (b"P5\n2 1\n255#c\n\x00\xff", "255 is followed by a `#` comment, where one whitespace "
+                                     "byte ends the header"),
+    (b"P5\n2 1\n255x\x00\xff", "followed by the byte 0x78"),
+    (b"P5\n2 1\n255", "cut short: nothing follows its maximum value"),
 ])
 def test_broken_pgms_are_refused_in_words(data, words):
     with pytest.raises(ValueError, match=words):

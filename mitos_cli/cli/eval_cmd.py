@@ -416,6 +416,33 @@ def _no_rule_hint(output: str, declared: bool) -> str:
             "to write the other rows (docs/interop.md)")
 
 
+def _fired_rows(compiled: CompiledRuleBase, result: Result, rows: np.ndarray,
+                j: int) -> np.ndarray:
+    """Of the rows where output ``j`` has no value (``rows``), those where a rule setting it
+    fires all the same (a Mamdani set 0 at every sample, Tsukamoto inverses at +inf and
+    -inf): "no rule sets it" there was untrue. Only those rows' DOFs are computed."""
+    import numpy as np
+
+    from ..engine.evaluation import rule_dofs
+
+    fired = np.zeros(len(rows), dtype=bool)
+    index = np.flatnonzero(rows)
+    dof = rule_dofs(compiled, result.inputs[index])
+    fired[index] = (dof[:, compiled.cons_mask[:, j]] > 0).any(axis=1)
+    return fired
+
+
+def _unset_words(out: str, count: int, fired: int, n: int) -> str:
+    """Why ``out`` has no value in ``count`` rows of ``n``, ``fired`` of them rows where its
+    rules fire."""
+    if not fired:
+        return f"no rule sets `{out}` in {plural(count, 'row')} of {n}"
+    if fired == count:
+        return f"the rules that fire give `{out}` no value in {plural(count, 'row')} of {n}"
+    return (f"no rule sets `{out}` in {plural(count - fired, 'row')} of {n}, and the rules "
+            f"that fire give it no value in {plural(fired, 'other')}")
+
+
 def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
                    where: Callable[[int], Span | None] | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -425,7 +452,7 @@ def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
     import numpy as np
 
     from ..engine.evaluation import declares_nan
-    from ..errors import NoRuleFiredError
+    from ..errors import EmptyOutputError, NoRuleFiredError
 
     Y = result.outputs.copy()
     unset = result.no_rule if result.no_rule is not None else np.zeros(Y.shape, dtype=bool)
@@ -438,23 +465,27 @@ def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
             continue
         declared = not np.isnan(compiled.default[j]) or declares_nan(compiled, out)
         shown = "nan" if np.isnan(compiled.default[j]) else f"{compiled.default[j]:g}"
+        fired = _fired_rows(compiled, result, rows, j)
         if policy is NoRule.error or (policy is NoRule.default and not declared):
             row = int(np.argmax(rows))
             values = ", ".join(f"{k}={exact(result.inputs[row, i])}"
                                for i, k in enumerate(compiled.inputs))
-            raise NoRuleFiredError(
-                f"no rule sets `{out}` for {values} (row {row + 1}; {count} of {n} rows)",
+            error = EmptyOutputError if fired[row] else NoRuleFiredError
+            what = (f"the rules that fire give `{out}` no value" if fired[row]
+                    else f"no rule sets `{out}`")
+            raise error(
+                f"{what} for {values} (row {row + 1}; {count} of {n} rows)",
                 span=None if where is None else where(row),
                 hint=_no_rule_hint(out, declared))
+        what = _unset_words(out, count, int(fired.sum()), n)
         if policy is NoRule.default:
-            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: the file's default "
-                 f"({shown}) is written there")
+            warn(f"{what}: the file's default ({shown}) is written there")
         elif policy is NoRule.nan:
             Y[rows, j] = np.nan
-            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: nan is written there")
+            warn(f"{what}: nan is written there")
         else:
             keep &= ~rows
-            warn(f"no rule sets `{out}` in {plural(count, 'row')} of {n}: left out")
+            warn(f"{what}: left out")
     flags = np.full(n, "", dtype=object)
     for j, out in enumerate(compiled.outputs):
         flags = np.where(unset[:, j], flags + (";" + out), flags)

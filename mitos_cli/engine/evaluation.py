@@ -1020,5 +1020,9 @@ def _why_empty(compiled: CompiledRuleBase, j: int) -> tuple[str, str]:
                 f"`{compiled.outputs[j]}` is sampled at, so there is nothing to defuzzify",
                 "widen the terms they conclude or raise `resolution` (`mitos check` names the "
                 "terms: undersampled-term), or ")
+    if compiled.operators.inference == "tsukamoto":
+        return ("the terms they conclude, inverted at those DOFs, lie at +inf and -inf (a "
+                "sigmoid reaches 1 only at infinity), and their weighted average has no value",
+                "conclude terms that reach 1 within the range (a ramp, an S or Z shape), or ")
     return ("their weights in it are 0 (a hedged consequent of a DOF so small that it "
             "underflows)", "")

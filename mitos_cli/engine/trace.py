@@ -54,6 +54,9 @@ class Trace:
     rules: tuple[RuleTrace, ...]          # fired rules only, in rule-base order
     outputs: tuple[tuple[str, float, str], ...]
     defaulted: tuple[str, ...] = ()       # outputs no rule set: their `default` applies
+    #: of ``defaulted``, those whose rules fire but give them no value (a Mamdani set 0 at
+    #: every sample, Tsukamoto inverses at +inf and -inf): their `default` applies too
+    unvalued: tuple[str, ...] = ()
 
     def __repr__(self) -> str:
         """A line: the behavior, the inputs as given, the outputs and how many rules fired
@@ -121,7 +124,9 @@ class Trace:
             lines.append("  (none)")
         lines += ["", "outputs:"]
         for name, value, unit in self.outputs:
-            note = "   (its default: no rule sets it here)" if name in self.defaulted else ""
+            note = "" if name not in self.defaulted else \
+                "   (its default: the rules that fire give it no value here)" \
+                if name in self.unvalued else "   (its default: no rule sets it here)"
             lines.append(f"  {name} = {with_unit(num(value), unit)}".rstrip() + note)
         return "\n".join(lines)
 
@@ -161,9 +166,16 @@ def trace_of(result: Result, row: int = 0, given: np.ndarray | None = None) -> T
     outputs = tuple((name, float(result.outputs[row, j]), c.variables[name].unit)
                     for j, name in enumerate(c.outputs))
     fired = result.dof[row] > 0
+    declared = [not np.isnan(c.default[j]) or declares_nan(c, name)
+                for j, name in enumerate(c.outputs)]
+    # rules that fire may give an output no value too (NaN before the default): its value is
+    # the default all the same (a Tsukamoto output of +inf and -inf printed the default as
+    # the rules' value, and `--json` listed it as set)
+    unvalued = tuple(name for j, name in enumerate(c.outputs)
+                     if declared[j] and fired[c.cons_mask[:, j]].any()
+                     and result.no_rule is not None and bool(result.no_rule[row, j]))
     defaulted = tuple(name for j, name in enumerate(c.outputs)
-                      if (not np.isnan(c.default[j]) or declares_nan(c, name))
-                      and not fired[c.cons_mask[:, j]].any())
+                      if declared[j] and (not fired[c.cons_mask[:, j]].any() or name in unvalued))
     path = display_path(c.rulebase.path)
     return Trace(path, c.behavior, c.describe_operators(), c.n_rules, tuple(inputs), rules,
-                 outputs, defaulted)
+                 outputs, defaulted, unvalued)

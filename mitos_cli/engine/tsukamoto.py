@@ -5,7 +5,10 @@ term are summed into that term's activation ``w`` (fuzzylite's aggregation ``non
 is inverted there, ``z = mu^-1(w)`` (:data:`mitos_cli.fuzzy.shapes.TSUKAMOTO`), and the output
 is ``sum(w z) / sum(w)`` over its terms (NaN where no rule fired). A term that did not fire
 (``w = 0``) adds nothing; where a term never reaches ``w`` (a sigmoid at ``w = 1``) its inverse
-is infinite and so is the output, as in fuzzylite. A consequent's hedges hedge its rule's
+is infinite and so is the output, as in fuzzylite; where rules fire fully on a term
+reaching 1 at +inf and one reaching it at -inf, the output has no value (NaN, as
+``inf - inf`` in fuzzylite; MITOS gives the declared default there, as where no rule fires,
+and says so). A consequent's hedges hedge its rule's
 degree, as in weighted-average inference. Loops run over outputs and their terms (a few),
 never over rules or samples; sums are :func:`~mitos_cli.engine.evaluation.tree_sum`'s, so a
 sample gives the same bits alone or in any batch.
@@ -70,7 +73,8 @@ def tsukamoto_outputs(compiled: CompiledRuleBase, dof: np.ndarray) -> np.ndarray
                 WZ[t] = np.where(w > 0.0, w * z, 0.0)
             W[t] = w
         den = tree_sum(W)
-        num = tree_sum(WZ)
+        with np.errstate(invalid="ignore"):     # +inf and -inf: NaN, said where it is used
+            num = tree_sum(WZ)
         with np.errstate(invalid="ignore", divide="ignore"):
             np.divide(num, den, out=out[j], where=den > 0.0)
     return out

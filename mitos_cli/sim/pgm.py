@@ -72,6 +72,8 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
     if width <= 0 or height <= 0 or not 0 < maxval < 65536:
         raise ValueError(f"bad PGM size {width} x {height} or maximum value {maxval}")
     check_size(width, height)
+    if magic == b"P5":
+        _check_header_end(data, offset, maxval)
     n = width * height
     depth = 2 if maxval > 255 else 1
     if magic == b"P5" and len(data) - offset < n * depth:   # before allocating anything
@@ -98,6 +100,26 @@ def parse_pgm(data: bytes) -> tuple[np.ndarray, int]:
         _within(pixels, maxval, width)
         pixels = pixels.astype(np.uint16)
     return pixels.reshape(height, width), maxval
+
+
+def _check_header_end(data: bytes, offset: int, maxval: int) -> None:
+    """Refuse a binary PGM whose maximum value is followed by anything but the one whitespace
+    byte that ends the header: that byte was skipped whatever it was, so a `#` comment right
+    after it (``255# made by hand``) had its text read as the first pixels, the map shifted
+    without a word (map_server's SDL_image reads it so too; netpbm skips the comment: the file
+    is mended, not guessed at); and nothing after it at all was "the image holds -1 of its
+    pixels". An ASCII (``P2``) raster skips comments and whitespace: it needs no check."""
+    if offset > len(data):
+        raise ValueError("the PGM header is cut short: nothing follows its maximum value")
+    end = data[offset - 1:offset]
+    if end.isspace():
+        return
+    if end == b"#":
+        raise ValueError(f"its maximum value {maxval} is followed by a `#` comment, where one "
+                         "whitespace byte ends the header and the pixels begin: put the "
+                         "comment on a line of its own, before the maximum value")
+    raise ValueError(f"its maximum value {maxval} is followed by the byte 0x{end[0]:02X}, "
+                     "where one whitespace byte ends the header and the pixels begin")
 
 
 def _check_line_end(data: bytes, offset: int, size: int) -> None:
