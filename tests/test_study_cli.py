@@ -159,12 +159,13 @@ def _alive(pids: set[int]) -> set[int]:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in /proc")
-@pytest.mark.parametrize("sig", [signal.SIGKILL], ids=["KILL"])
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["KILL", "TERM"])
 def test_a_study_stopped_mid_run_lets_go_of_its_directory_at_once(tiny, tmp_path, compare, sig):
     """`kill -9` of a `compare` on a pool: its workers ran their chunks on, seconds, holding
     the directory's lock (a --resume at once: "`DIR` is in use by another study", exit 1)
-    and printing the tracebacks of the pipes they found broken. Killed, the workers end with
-    it."""
+    and printing the tracebacks of the pipes they found broken. A SIGTERM ended it so too,
+    without a word of what was kept. Killed, the workers end with it; terminated, it stops as
+    on Ctrl-C (exit 143)."""
     out = tmp_path / "killed"
     args = [tiny, "--planner", "fuzzy", "--and", "min,product", "--runs", "24", "-j", "2",
             "-o", str(out), "--no-plots"]
@@ -192,7 +193,12 @@ def test_a_study_stopped_mid_run_lets_go_of_its_directory_at_once(tiny, tmp_path
     before = ResultStore(out).load()
     assert 24 <= len(before) < 48, "the study should have been stopped half-way"
     said = log.read_text()
-    assert code == -signal.SIGKILL and "Traceback" not in said
+    if sig == signal.SIGKILL:
+        assert code == -signal.SIGKILL and "Traceback" not in said
+    else:
+        assert code == 143, said
+        assert f"interrupted: {len(before)} of 48 runs kept in {results}" in said
+        assert f"--runs 24 --seed 1 -o {out} -j 2 --no-plots --resume" in said
     ran = compare(*args, "--resume")                # at once
     assert ran.exit_code == 0, ran.stderr
     assert f"{48 - len(before)} runs now, {len(before)} from before" in ran.stderr

@@ -61,10 +61,14 @@ def _chunk_runs(task: tuple) -> Iterator[Part]:
 
 def ignore_interrupts() -> None:
     """A pool worker's initializer: Ctrl-C reaches the whole process group, and only the
-    parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``)."""
+    parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``).
+    A SIGTERM ends the worker as the signal does, whatever the parent answers it with
+    (``mitos compare`` stops as on Ctrl-C: a worker forked with that handler raised where
+    ``Pool.terminate`` ends it)."""
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def end_with_parent(started_by_main_thread: bool) -> None:
