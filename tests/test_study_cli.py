@@ -134,6 +134,79 @@ def test_killed_sweep_resumes_without_recomputing(tiny, tmp_path):
     assert after[:len(before)] == before                       # finished rows untouched
 
 
+def _children(pid: int) -> set[int]:
+    """The live processes whose parent is ``pid`` (Linux's /proc)."""
+    found = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            state, ppid = stat.read_text().rsplit(")", 1)[1].split()[:2]
+        except (OSError, IndexError):
+            continue                        # (ended while we looked)
+        if int(ppid) == pid and state != "Z":
+            found.add(int(stat.parent.name))
+    return found
+
+
+def _alive(pids: set[int]) -> set[int]:
+    alive = set()
+    for pid in pids:
+        try:
+            if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z":
+                alive.add(pid)
+        except (OSError, IndexError):
+            pass
+    return alive
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in /proc")
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["KILL", "TERM"])
+def test_a_study_stopped_mid_run_lets_go_of_its_directory_at_once(tiny, tmp_path, compare, sig):
+    """`kill -9` of a `compare` on a pool: its workers ran their chunks on, seconds, holding
+    the directory's lock (a --resume at once: "`DIR` is in use by another study", exit 1)
+    and printing the tracebacks of the pipes they found broken. A SIGTERM ended it so too,
+    without a word of what was kept. Killed, the workers end with it; terminated, it stops as
+    on Ctrl-C (exit 143)."""
+    out = tmp_path / "killed"
+    args = [tiny, "--planner", "fuzzy", "--and", "min,product", "--runs", "24", "-j", "2",
+            "-o", str(out), "--no-plots"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    log = tmp_path / "stderr.txt"
+    with open(log, "w") as stderr:
+        proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "compare", *args], env=env,
+                                stdout=subprocess.DEVNULL, stderr=stderr)
+    results = out / "results.csv"
+    deadline = time.monotonic() + 60
+    try:
+        # the first choice's 24 runs are in: both workers are in the second's chunks
+        while time.monotonic() < deadline and proc.poll() is None:
+            if results.exists() and results.read_text().count("\n") >= 25:
+                break
+            time.sleep(0.01)
+        workers = _children(proc.pid)
+    finally:
+        proc.send_signal(sig)
+        code = proc.wait(timeout=60)
+    gone = time.monotonic() + 1.0
+    while _alive(workers) and time.monotonic() < gone:
+        time.sleep(0.01)
+    assert len(workers) >= 2 and not _alive(workers), "the workers ran on"
+    before = ResultStore(out).load()
+    assert 24 <= len(before) < 48, "the study should have been stopped half-way"
+    said = log.read_text()
+    if sig == signal.SIGKILL:
+        assert code == -signal.SIGKILL and "Traceback" not in said
+    else:
+        assert code == 143, said
+        assert f"interrupted: {len(before)} of 48 runs kept in {results}" in said
+        assert f"--runs 24 --seed 1 -o {out} -j 2 --no-plots --resume" in said
+    ran = compare(*args, "--resume")                # at once
+    assert ran.exit_code == 0, ran.stderr
+    assert f"{48 - len(before)} runs now, {len(before)} from before" in ran.stderr
+    after = ResultStore(out).load()
+    assert len({(x["and"], x["run"]) for x in after}) == len(after) == 48
+    assert after[:len(before)] == before
+
+
 def test_a_reader_that_stops_early_still_gets_the_report_written(tiny, tmp_path):
     """`mitos compare ... | head -1`: the tables went to stdout before report.md was written,
     so a reader that had gone ended the command before the study's report."""

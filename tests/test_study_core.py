@@ -503,6 +503,30 @@ def test_a_directory_a_study_runs_in_is_refused_to_another(tmp_path):
     assert outcome.executed == 6 and len(ResultStore(tmp_path).load()) == 6
 
 
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="a child that shares the lock is forked")
+def test_a_child_forked_while_a_study_runs_does_not_hold_its_directory(tmp_path):
+    """A flock belongs to the open file, which a forked child shares: the pool's workers of a
+    study killed with `kill -9` held its directory while they ran on, and a --resume at once
+    was refused ("in use by another study")."""
+    study = small_study(runs=1)
+    running = ResultStore(tmp_path)
+    running.start(study.manifest(), study.tasks(), resume=False)
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:                        # the child: lives until the parent lets it end
+        os.close(w)
+        os.read(r, 1)
+        os._exit(0)
+    os.close(r)
+    try:
+        running.close()                 # the study's process lets go; its child lives on
+        outcome = run_study(study, tmp_path, workers=1, resume=True, task_fn=fake_sim)
+        assert outcome.executed == 6 and len(ResultStore(tmp_path).load()) == 6
+    finally:
+        os.close(w)
+        os.waitpid(pid, 0)
+
+
 def test_a_choice_given_twice_is_refused(tmp_path):
     """Its runs shared one key: each summarized both (n = 2 of 1 run) and were written
     twice, which the study's own --resume then refused."""

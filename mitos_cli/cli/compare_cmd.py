@@ -13,7 +13,7 @@ from ..words import plural
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, WORDS, Number, named, option_names
-from .progress import INTERRUPTED, progress_bar
+from .progress import INTERRUPTED, progress_bar, stopped_code, terminate_as_interrupt
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -331,7 +331,8 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
                       resume: bool, quiet: bool = False, how: str = "") -> Outcome:
     """Run the study with a progress bar on stderr (on a terminal, without ``--json``; piped,
     a line every few percent). On Ctrl-C: say how many runs are kept in ``out`` and how to go
-    on (the study's command, then ``how``: the options it was run with), and exit 130."""
+    on (the study's command, then ``how``: the options it was run with), and exit 130; on a
+    SIGTERM the same, exiting 143."""
     from ..study import run_study
 
     kept = {"before": 0, "now": 0, "total": 0}
@@ -347,20 +348,21 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
             bar.update(kept["before"] + kept["now"], kept["total"])
 
         try:
-            return run_study(study, out, executor=executor, workers=workers,
-                             scheduler=scheduler, resume=resume, on_start=on_start,
-                             on_result=on_result,
-                             on_clock=lambda t: bar.status(f"at {t:.0f} s"))
-        except KeyboardInterrupt:
-            pass
+            with terminate_as_interrupt():
+                return run_study(study, out, executor=executor, workers=workers,
+                                 scheduler=scheduler, resume=resume, on_start=on_start,
+                                 on_result=on_result,
+                                 on_clock=lambda t: bar.status(f"at {t:.0f} s"))
+        except KeyboardInterrupt as exc:        # (a SIGTERM too: Terminated)
+            stopped = stopped_code(exc)
     if not kept["total"] and not resume:      # before on_start: no run of it is kept
         err(f"interrupted before the study began in {out}; start it with:\n  {study.command}{how}")
-        raise typer.Exit(INTERRUPTED)
+        raise typer.Exit(stopped)
     done = max(kept["before"] + kept["now"], _rows_in(out))
     err(f"interrupted: {done} of {plural(kept['total'], 'run')} kept in "
         f"{Path(out) / 'results.csv'} ({done - kept['before']} now, {kept['before']} from "
         f"before); go on with:\n  {study.command}{how} --resume")
-    raise typer.Exit(INTERRUPTED)
+    raise typer.Exit(stopped)
 
 
 def _rows_in(out: str) -> int:

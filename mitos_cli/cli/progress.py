@@ -16,6 +16,9 @@ if TYPE_CHECKING:
 #: The exit code of a command stopped by Ctrl-C (128 + SIGINT), as shells report it.
 INTERRUPTED = 130
 
+#: The exit code of a command stopped by SIGTERM (128 + SIGTERM), as shells report it.
+TERMINATED = 143
+
 
 #: Off a terminal, a progress line each time this many more percent are done.
 LINE_EVERY_PERCENT = 5
@@ -82,3 +85,37 @@ def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> 
                   TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(),
                   console=console, transient=True) as progress:
         yield Bar(progress, console, what=description)
+
+
+class Terminated(KeyboardInterrupt):
+    """A SIGTERM (``kill PID``, a batch scheduler's time limit) raised where the command is, as
+    Ctrl-C raises KeyboardInterrupt: what stops cleanly on one stops so on the other."""
+
+
+def stopped_code(exc: KeyboardInterrupt) -> int:
+    """The exit code of a command stopped by ``exc``: 143 for a SIGTERM, else 130."""
+    return TERMINATED if isinstance(exc, Terminated) else INTERRUPTED
+
+
+@contextmanager
+def terminate_as_interrupt() -> Iterator[None]:
+    """While the block runs, a SIGTERM raises :class:`Terminated` (``mitos compare``: its
+    runs kept, the workers ended, the command that goes on said, where the signal ended the
+    process at once and left that to be guessed). Not from a thread other than the main
+    one (only it may set a handler), nor where SIGTERM is ignored (a caller's choice)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGTERM) is signal.SIG_IGN:
+        yield
+        return
+
+    def terminated(signum: int, frame: object) -> None:
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

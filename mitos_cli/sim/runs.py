@@ -26,6 +26,7 @@ from .world import World
 
 if TYPE_CHECKING:
     from multiprocessing.pool import AsyncResult
+    from multiprocessing.process import BaseProcess
     from multiprocessing.queues import Queue
 
     from .loop import SimResult
@@ -60,10 +61,64 @@ def _chunk_runs(task: tuple) -> Iterator[Part]:
 
 def ignore_interrupts() -> None:
     """A pool worker's initializer: Ctrl-C reaches the whole process group, and only the
-    parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``)."""
+    parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``).
+    A SIGTERM ends the worker as the signal does, whatever the parent answers it with
+    (``mitos compare`` stops as on Ctrl-C: a worker forked with that handler raised where
+    ``Pool.terminate`` ends it)."""
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def end_with_parent(started_by_main_thread: bool) -> None:
+    """A pool worker's initializer: end at once when the process that started the pool is
+    gone. Nothing terminates the pool of a process killed (``kill -9``, the out-of-memory
+    killer): its workers ran their chunks to the end, seconds, printing the tracebacks of
+    the pipes they found broken, and held what they had inherited, the lock of a study's
+    directory among them (a `--resume` at once was refused: "in use by another study").
+
+    Linux kills the worker with its parent (``PR_SET_PDEATHSIG``, asked for only when the
+    main thread starts the pool: it fires when the *thread* that forked the worker ends);
+    everywhere, a thread waits on the parent's sentinel (a pipe that the parent's end
+    closes) and ends the process.
+    """
+    import multiprocessing
+    import threading
+
+    if started_by_main_thread:
+        _killed_with_parent()
+    parent = multiprocessing.parent_process()
+    if parent is None:                  # (not a worker of multiprocessing's)
+        return
+    if not parent.is_alive():           # gone before the kernel was asked
+        os._exit(1)
+    threading.Thread(target=_end_when_gone, args=(parent,), name="mitos-parent-watch",
+                     daemon=True).start()
+
+
+def _killed_with_parent() -> None:
+    """Ask Linux for a SIGKILL when the parent goes (``prctl(PR_SET_PDEATHSIG)``); nothing
+    elsewhere, or where the C library does not answer."""
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+    import signal
+
+    pr_set_pdeathsig = 1                # (linux/prctl.h)
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(pr_set_pdeathsig, ctypes.c_ulong(signal.SIGKILL), ctypes.c_ulong(0),
+                   ctypes.c_ulong(0), ctypes.c_ulong(0))
+    except (OSError, AttributeError):
+        pass
+
+
+def _end_when_gone(parent: BaseProcess) -> None:
+    parent.join()                       # (returns when the parent's end of the pipe closes)
+    os._exit(1)
 
 
 def trail(res: SimResult) -> dict:
@@ -317,9 +372,10 @@ def even_chunks(n: int, workers: int, most: int) -> int:
 _outbox: Any = None
 
 
-def _streaming_worker(outbox: Queue) -> None:
+def _streaming_worker(outbox: Queue, started_by_main_thread: bool) -> None:
     global _outbox
     ignore_interrupts()
+    end_with_parent(started_by_main_thread)
     _outbox = outbox
 
 
@@ -344,16 +400,19 @@ def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list,
     """What the generator ``fn(item)`` yields, for each item, on a pool of ``workers``
     processes, as each part is made. A worker's error is raised here, and so is
     :class:`WorkerLost` when a worker dies; on Ctrl-C or an error the workers are terminated
-    at once, not left to finish."""
+    at once, not left to finish, and they end at once when this process is killed
+    (:func:`end_with_parent`)."""
     import functools
     import multiprocessing
     import pickle
     import queue
+    import threading
 
     context = multiprocessing.get_context()
     outbox = context.Queue()
     others = {p.pid for p in multiprocessing.active_children()}
-    pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox,))
+    main = threading.current_thread() is threading.main_thread()
+    pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox, main))
     started = {p.pid for p in multiprocessing.active_children()} - others
     finished = False
     try:

@@ -12,13 +12,16 @@ keep the names of the worlds they were written with.
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import functools
 import io
 import json
 import math
 import os
 import re
 import shlex
+import weakref
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
@@ -550,7 +553,13 @@ class ResultStore:
         """Lock the directory for this study until :meth:`close` (or the process's end, a
         kill included): two studies in one directory both appended to its results.csv, each
         run held twice, and both said they had finished. Where locks are not to be had (not
-        POSIX, a file system without them), the study goes on as before."""
+        POSIX, a file system without them), the study goes on as before.
+
+        The lock is this process's alone: a ``flock`` belongs to the open file, which a
+        forked child shares, so the workers of the study's pool held it too, and those of a
+        study killed with ``kill -9`` kept it while they ran on (a `--resume` at once was
+        refused). A child forked from here closes its copy at once (:func:`_let_go`); one
+        started by ``exec`` never gets it (the descriptor is not inheritable)."""
         try:
             import fcntl
         except ImportError:
@@ -570,6 +579,8 @@ class ResultStore:
             os.close(fd)
             return
         self._held = fd
+        _HOLDING.add(self)
+        _not_into_children()
 
     def _mend(self) -> None:
         """End the file where its last whole row ends, before rows are appended to it: a row
@@ -597,12 +608,36 @@ class ResultStore:
         if self._held is not None:
             os.close(self._held)            # (which lets the lock go)
             self._held = None
+            _HOLDING.discard(self)
 
     def __enter__(self) -> ResultStore:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+#: the stores that hold their directory's lock in this process (:meth:`ResultStore._hold`)
+_HOLDING: weakref.WeakSet[ResultStore] = weakref.WeakSet()
+
+
+def _let_go() -> None:
+    """In a child just forked: close the locked directories' descriptors it inherited (the
+    locks stay with the parent), and forget them (the child's copy of a store must not close
+    a number that has come to name another file)."""
+    for store in list(_HOLDING):
+        if store._held is not None:
+            with contextlib.suppress(OSError):
+                os.close(store._held)
+            store._held = None
+    _HOLDING.clear()
+
+
+@functools.cache
+def _not_into_children() -> None:
+    """Have every child forked from now on let the locks go (once a process)."""
+    if hasattr(os, "register_at_fork"):
+        os.register_at_fork(after_in_child=_let_go)
 
 
 def _refuse_special(path: Path, kind: str) -> None:
