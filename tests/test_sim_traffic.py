@@ -235,20 +235,75 @@ def test_a_robot_told_to_stop_where_it_gives_way_is_waiting_not_stuck(tmp_path):
     assert not sim.done
 
 
-def test_the_echoes_of_the_robot_waited_on_are_told_apart_from_walls_and_other_robots():
-    """A robot waiting on another (``waits``) reads its echoes as that robot's: a reading
-    ending on its body, noise within :data:`ECHO_PAD` included; not one ending on a wall
-    behind it, nor on a third robot beside it, nor the readings of a robot that waits on
-    none."""
+def test_the_echoes_of_each_robot_are_told_apart_from_walls_and_from_each_other():
+    """A reading is robot ``j``'s echo when it ends on ``j``'s body, noise within
+    :data:`ECHO_PAD` included: not one ending on a wall behind it, nor a robot's own."""
     pose = np.array([[0.0, 0.0, 0.0], [100.0, 0.0, math.pi / 2], [100.0, 60.0, 0.0]])
     dirs = np.array([[[1.0, 0.0], [0.0, 1.0], [100 / math.hypot(100, 60), 60 / math.hypot(100, 60)]]] * 3)
     # robot 0's beams: along +x onto robot 1's side (its body spans x 91..109), up to a
-    # wall, and onto robot 2, standing 60 in above robot 1
+    # wall, and onto robot 2, standing 60 in above robot 1 (its body spans x 88..112)
     ranges = np.array([[91.0 + 4.0, 150.0, math.hypot(100, 60) - 12.0]] * 3)
-    seen = traffic.echoes([(0, 1)], pose, [ROBOT] * 3, ranges, dirs)
-    assert seen.tolist() == [[True, False, False], [False] * 3, [False] * 3]
+    of = traffic.echoes(pose, [ROBOT] * 3, ranges, dirs)
+    assert of.shape == (3, 3, 3)
+    assert of[0, 1].tolist() == [True, False, False]
+    assert of[0, 2].tolist() == [False, False, True]
+    assert not of[[0, 1, 2], [0, 1, 2]].any()
     ranges[0, 0] = 91.0 - traffic.ECHO_PAD - 0.5           # short of the body: something else
-    assert not traffic.echoes([(0, 1)], pose, [ROBOT] * 3, ranges, dirs)[0, 0]
+    assert not traffic.echoes(pose, [ROBOT] * 3, ranges, dirs)[0, 1, 0]
+
+
+def test_mates_are_the_other_robots_that_share_and_still_drive():
+    share, active = [True, True, False, True], np.array([True, True, True, False])
+    assert traffic.mates(share, active).tolist() == [
+        [False, True, False, False], [True, False, False, False],
+        [False, False, False, False], [False, False, False, False]]
+
+
+def test_a_robot_leaves_off_its_map_the_mates_that_move_and_the_one_it_waits_on():
+    """Robot 0 waits on robot 2, which stands in the crossing; robot 1 drives by; robot 3
+    stands still; robot 4 shares nothing. Robot 0 marks 3 and 4 (standing things, a robot
+    outside the fleet), never 1 nor 2; the others mark 2 and 3 where they stand."""
+    share = [True, True, True, True, False]
+    active = np.ones(5, dtype=bool)
+    speed = np.array([0.0, 30.0, 0.0, traffic.MOVING / 2, 30.0])
+    off = traffic.unmarked(share, active, speed, [(0, 2)])
+    assert off.tolist() == [[False, True, True, False, False],
+                            [False, False, False, False, False],
+                            [False, True, False, False, False],
+                            [False, True, False, False, False],
+                            [False, False, False, False, False]]
+
+
+@settings(max_examples=60, deadline=None)
+@given(heading=st.floats(-math.pi, math.pi), ahead=st.floats(-80, 80),
+       half=st.sampled_from([1.0, 2.5, 5.0]))
+def test_a_mates_outline_lies_flush_inside_its_stretched_footprint_without_gaps(
+        heading, ahead, half):
+    """The squares laid round a mate's footprint (stretched by the room it takes to stop)
+    lie inside it, reach its edges, and leave no gap a brake's sweep could pass through."""
+    pose = np.array([[10.0, -20.0, heading]])
+    out = traffic.outlines(pose, [ROBOT], np.array([True]), half, np.array([ahead]))[0]
+    c, s = math.cos(heading), math.sin(heading)
+    rel = out - pose[0, :2]
+    u, v = rel @ np.array([c, s]), rel @ np.array([-s, c])
+    a, b = ROBOT.length / 2 - half, ROBOT.width / 2 - half
+    lo, hi = -a + min(ahead, 0.0), a + max(ahead, 0.0)
+    assert (u >= lo - 1e-9).all() and (u <= hi + 1e-9).all()
+    assert (np.abs(v) <= b + 1e-9).all()
+    assert math.isclose(u.min(), lo, abs_tol=1e-9) and math.isclose(u.max(), hi, abs_tol=1e-9)
+    assert math.isclose(np.abs(v).max(), b, abs_tol=1e-9)
+    # along each long side the squares touch or overlap: no gap
+    side = np.sort(u[np.isclose(v, b)])
+    assert (np.diff(side) <= 2 * half + 1e-9).all()
+    assert traffic.outlines(pose, [ROBOT], np.array([False]), half, np.array([ahead]))[0].shape == (0, 2)
+
+
+def test_a_mate_is_stretched_by_the_room_it_takes_to_stop_a_tick_late():
+    """At 40 in/s with an acceleration of 40 in/s^2 a robot drives 20 in braking, and 2 in
+    in the tick before: 22 in ahead; backing out at 10 in/s, 1.75 in behind."""
+    robot = dataclasses.replace(ROBOT, acceleration=40.0)
+    ahead = traffic.stopping(np.array([40.0, -10.0, 0.0]), [robot] * 3, DT)
+    assert np.allclose(ahead, [22.0, -1.75, 0.0])
 
 
 def test_a_robot_that_waited_at_a_crossing_goes_on_without_planning_round_the_other():
@@ -272,3 +327,18 @@ def test_dwa_gets_going_again_after_giving_way_at_a_t_junction():
     world = load_world(DATA / "traffic" / "tee_left_turn.yaml")
     res = simulate(world, make_planner("dwa", world), seed=1000, randomise=True)
     assert res.robot_outcomes == ("success", "success")
+
+
+def test_six_robots_that_drive_by_each_other_leave_no_trails_and_all_arrive():
+    """``crossroads6`` seeds 1000 and 1001: robots overtaking a mate that gave way swerved
+    into the oncoming lane round the trails their maps held of mates driving by, and two
+    met head-on in the crossing (collisions at 15.7 and 20.7 s). Leaving moving mates off
+    the maps, and braking for their bodies stretched by their stopping room, all six
+    arrive, alike alone and in a batch."""
+    from test_sim_lockstep import assert_same_run
+
+    world = load_world(DATA / "traffic" / "crossroads6.yaml")
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    together = run_lockstep(world, planner, [1000, 1001], randomise=True, scene=scene)
+    assert [res.robot_outcomes for res in together] == [("success",) * 6] * 2
+    assert_same_run(simulate(world, planner, 1000, randomise=True, scene=scene), together[0])

@@ -654,6 +654,7 @@ class Simulation:
         self._outcomes = ["timeout"] * n
         self._collided = 0
         self._k = 0
+        self._bodies_at: tuple = (-1, 0.0, None, [])   # tick, half a cell, mates, outlines
         self._done = self.steps <= 0
         self._hit = np.zeros(n, dtype=bool)
         self._beyond_at: tuple = (None, [])             # see _beyond()
@@ -1135,16 +1136,51 @@ class Simulation:
         if self._given.knows != "none":
             expected = self._expected[0][None] if self.n == 1 else np.stack(self._expected)
         seen = _news(s.ranges, expected, self.world.sensors.range * 0.999, self._threshold)
-        if self._ways.waits:
-            seen &= ~self._mates_echoes(s.pose, s.ranges, self._dirs)
-        self._seen = list(seen)
+        tracked = seen
+        if self._traffic:
+            seen, tracked = self._mates_echoes(seen, self._active, s.pose, self._v, s.ranges,
+                                               self._dirs)
+        self._seen = list(tracked)
         return seen
 
-    def _mates_echoes(self, pose: np.ndarray, ranges: np.ndarray,
-                      dirs: list[np.ndarray] | np.ndarray) -> np.ndarray:
-        """``[n, B]``: the readings of each robot that gives way that are echoes of the robot
-        it waits on (:func:`.traffic.echoes`): news to neither its map nor its tracks."""
-        return traffic.echoes(self._ways.waits, pose, self.robots, ranges, np.asarray(dirs))
+    def _mates_echoes(self, seen: np.ndarray, active: np.ndarray, pose: np.ndarray,
+                      speed: np.ndarray, ranges: np.ndarray, dirs: list[np.ndarray] | np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """``seen [n, B]`` without the echoes of the mates each robot leaves off its map
+        (:func:`.traffic.unmarked`, of the robots ``active`` at ``speed``; the brake counts
+        their bodies instead, :meth:`_mates_bodies`), and without those of the robot each
+        waits on only: what goes into its tracks, where a mate coming down its lane is a
+        mover it keeps right of (:func:`.traffic.echoes`)."""
+        off = traffic.unmarked(self._traffic, active, speed, self._ways.waits)
+        if not off.any():
+            return seen, seen
+        of = traffic.echoes(pose, self.robots, ranges, np.asarray(dirs))      # [n, n, B]
+        marked = seen & ~np.logical_or.reduce(of & off[:, :, None], axis=1)
+        if not self._ways.waits:
+            return marked, seen
+        waits = np.zeros_like(off)
+        for me, other in self._ways.waits:
+            waits[me, other] = True
+        return marked, seen & ~np.logical_or.reduce(of & waits[:, :, None], axis=1)
+
+    def _mates_bodies(self, i: int, active: np.ndarray, pose: np.ndarray,
+                      speed: np.ndarray) -> np.ndarray | None:
+        """What robot ``i``'s brake counts of its mates this tick: their footprints
+        stretched by the room each takes to stop (:func:`.traffic.outlines` of the robots
+        ``active`` at ``pose [n, 3]`` and ``speed [n]``, made once a tick for all); ``None``
+        where it has none."""
+        half = self._maps[i].grid.resolution / 2
+        if self._bodies_at[:2] != (self._k, half):
+            share = traffic.mates(self._traffic, active)
+            stretch = traffic.stopping(speed, self.robots, self.dt)
+            self._bodies_at = (self._k, half, share,
+                               traffic.outlines(pose, self.robots, np.asarray(share.any(axis=0)), half,
+                                                stretch))
+        share, outlines = self._bodies_at[2:]
+        of = share[i].nonzero()[0].tolist()
+        if not of:
+            return None
+        return outlines[of[0]] if len(of) == 1 else np.concatenate([outlines[j] for j in of])
 
     def watching(self, s: _Sensed, learned: list[bool] | None = None
                  ) -> tuple[list[movers.FreeSpace], np.ndarray, np.ndarray, np.ndarray,
@@ -1338,9 +1374,16 @@ class Simulation:
         rows = (self._active & fleet.brakes).nonzero()[0]
         maps = [self._maps[i] for i in rows.tolist()]
 
+        pose = np.stack([self._x, self._y, self._h], axis=1) if self._traffic else None
+
         def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
-            return [maps[k].brake_cells(p, r) for k, p, r in zip(j.tolist(), points,
-                                                                 half.tolist())]
+            cells = [maps[k].brake_cells(p, r) for k, p, r in zip(j.tolist(), points,
+                                                                  half.tolist())]
+            if pose is not None:
+                cells = [_with_mates(c, self._mates_bodies(int(rows[k]), self._active, pose,
+                                                           self._v))
+                         for k, c in zip(j.tolist(), cells)]
+            return cells
 
         now = (self._x, self._y, self._h, self._steer, self._v, s.inputs["heading"])
         for i in fleet.guard(rows, s.command, self._recovery, now, near):
@@ -1563,6 +1606,11 @@ def _sights(aims: list[perception.Aim], robots: list, pose: np.ndarray, dirs: np
     return perception.Sights([a.route for a in aims], [a.f for a in aims], robots, pose, dirs,
                              measured, expected, spacing, threshold,
                              np.where(room > 0.0, room, 0.0), least, kept, targets, squeeze)
+
+
+def _with_mates(cells: np.ndarray, bodies: np.ndarray | None) -> np.ndarray:
+    """A robot's brake cells, then its mates' bodies (``None``: it has none)."""
+    return cells if bodies is None else np.concatenate([cells, bodies])
 
 
 def _news(ranges: np.ndarray, expected: np.ndarray | None, far: float,
@@ -1819,10 +1867,12 @@ class Batch:
             expected = (self.got.static if self._plain else
                         np.array([e for run in self.runs for e in run._expected]))
         self._seen = seen = _news(self.got.ranges, expected, self._far, self._threshold)
-        for run, a, b in self._traffic:
-            if run._ways.waits:
-                seen[a:b] &= ~run._mates_echoes(self.pose[a:b], self.got.ranges[a:b],
-                                                self.got.dirs[a:b])
+        if self._traffic:
+            seen = seen.copy()
+        for run, a, b in self._traffic:           # (from the news, ``seen`` being a copy)
+            seen[a:b], self._seen[a:b] = run._mates_echoes(
+                self._seen[a:b], self._active[a:b], self.pose[a:b], self._drive[0][a:b],
+                self.got.ranges[a:b], self.got.dirs[a:b])
         return seen           # (no run's own: a run reads it only where it marks its map)
 
     def tracked(self, sighted: list[movers.Seen]) -> None:
@@ -2012,14 +2062,30 @@ class Batch:
         maps = self.maps if len(rows) == len(self.maps) else [self.maps[i] for i in rows.tolist()]
 
         def near(j: np.ndarray, points: np.ndarray, half: np.ndarray) -> list[np.ndarray]:
-            return knowledge.brake_cells_all(maps if len(j) == len(maps) else
-                                             [maps[k] for k in j.tolist()], points, half)
+            cells = knowledge.brake_cells_all(maps if len(j) == len(maps) else
+                                              [maps[k] for k in j.tolist()], points, half)
+            if self._traffic:
+                cells = [self._with_mates(int(rows[k]), c, x, y, h, v)
+                         for k, c in zip(j.tolist(), cells)]
+            return cells
 
         backs = fleet.guard(rows, self.command, self._recovery,     # (the runs' too)
                             (x, y, h, steer, v, self.block[_SIDE]), near)
         for row in backs:
             run, i = self._owner[row]
             run._backed.append((run._k, i))
+
+    def _with_mates(self, row: int, cells: np.ndarray, x: np.ndarray, y: np.ndarray,
+                    h: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``cells`` (what the map of the robot of batch ``row`` holds round its sweep), then
+        its mates' bodies (:meth:`Simulation._mates_bodies`) where its run's robots share."""
+        run, i = self._owner[row]
+        if not run._traffic:
+            return cells
+        a = row - i
+        pose = np.stack([x[a:a + run.n], y[a:a + run.n], h[a:a + run.n]], axis=1)
+        return _with_mates(cells, run._mates_bodies(i, self._active[a:a + run.n], pose,
+                                                    v[a:a + run.n]))
 
     def verdict(self) -> list[Simulation]:
         """:meth:`Simulation.verdict` of every run, once the guard has had its say: the

@@ -23,9 +23,13 @@ manager), and give way by the rule of the road:
   comes within the zone of the other's route and :data:`SLACK` more, measured straight to that
   route (never more than along its own, whatever a replanning does to either route); a robot
   already inside stops where it is. It goes on once the other's route, rear included, has
-  left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`), and it marks
-  neither on its map nor in its tracks the echoes of the robot it waits on
-  (:func:`echoes`): the fleet shares where that robot is.
+  left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`), and it leaves
+  the echoes of the robot it waits on out of its tracks;
+- **mates are not walls**: a robot leaves off its map the echoes (:func:`echoes`) of the
+  robots of its fleet that drive by, and of the one it waits on (:func:`unmarked`); its
+  brake counts their bodies instead, each stretched by the room it takes to stop
+  (:func:`outlines`, :func:`stopping`), as each robot's brake stops it short of the others'
+  so stretched. A mate that stands is marked where it stands, and routes go round it.
 
 It is a limit on every planner's command, as the brake is (a user's planner, DWA, a
 Gymnasium action), and it reads only what the robots share, never the world. Each run keeps
@@ -63,6 +67,10 @@ ECHO_PAD = 5.0
 #: in: a robot giving way stops this much short of the crossing's edge; it is committed only
 #: when it could not stop short of the edge itself (so braking to give way never commits it)
 SLACK = 12.0
+#: in/s: a mate this fast is driving by, and is left off the others' maps (:func:`unmarked`);
+#: slower, it stands in the way and is marked where it stands (a little under the slowest
+#: a tracker takes for moving, :data:`.movers.MIN_SPEED`, 6 in/s)
+MOVING = 5.0
 #: in: how far from its route a robot may drive: its keep-right lane (perception's ``road_cap``
 #: of 100 in, a quarter of it)
 LANE = 25.0
@@ -229,23 +237,81 @@ class Traffic:
         return out
 
 
-def echoes(waits: Iterable[tuple[int, int]], pose: np.ndarray, robots: Sequence[Robot],
-           ranges: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """``[n, B]``: which of each robot's readings (``ranges [n, B]`` along ``dirs [n, B, 2]``
-    from ``pose [n, 3]``, heading in radians) are echoes of the robot it waits on (``waits``:
-    pairs of a robot and the robot it gives way to): the reading ends within
-    :data:`ECHO_PAD` of that robot's body. Marked on the waiting robot's map, the robot
-    passing through the crossing was a trail of walls across it, which the waiting robot
-    planned round once it could go (into the crossing's corner, or stuck with DWA)."""
-    out = np.zeros(ranges.shape, dtype=bool)
-    for me, other in waits:
-        x, y, h = pose[other]
-        rel = pose[me, None, :2] + ranges[me, :, None] * dirs[me] - (x, y)
-        c, s = math.cos(h), math.sin(h)
-        along = np.abs(rel[:, 0] * c + rel[:, 1] * s) - robots[other].length / 2
-        side = np.abs(rel[:, 1] * c - rel[:, 0] * s) - robots[other].width / 2
-        out[me] |= np.hypot(np.maximum(along, 0.0), np.maximum(side, 0.0)) <= ECHO_PAD
+def echoes(pose: np.ndarray, robots: Sequence[Robot], ranges: np.ndarray,
+           dirs: np.ndarray) -> np.ndarray:
+    """``[n, n, B]``: which of each robot's readings (``ranges [n, B]`` along ``dirs [n, B,
+    2]`` from ``pose [n, 3]``, heading in radians) are echoes of each other robot: the
+    reading ends within :data:`ECHO_PAD` of that robot's body (a robot's own row is all
+    ``False``): what a robot leaves off its map of the robots :func:`unmarked` says."""
+    n = len(robots)
+    ends = pose[:, None, :2] + ranges[:, :, None] * dirs               # [n, B, 2]
+    rel = ends[:, None] - pose[None, :, None, :2]                      # [n, n, B, 2]
+    c, s = np.cos(pose[:, 2])[None, :, None], np.sin(pose[:, 2])[None, :, None]
+    half_l = np.array([r.length / 2 for r in robots])[None, :, None]
+    half_w = np.array([r.width / 2 for r in robots])[None, :, None]
+    along = np.abs(rel[..., 0] * c + rel[..., 1] * s) - half_l
+    side = np.abs(rel[..., 1] * c - rel[..., 0] * s) - half_w
+    out = np.hypot(np.maximum(along, 0.0), np.maximum(side, 0.0)) <= ECHO_PAD
+    out[np.arange(n), np.arange(n)] = False
     return out
+
+
+def mates(share: Sequence[bool], active: np.ndarray) -> np.ndarray:
+    """``[n, n]``: which robots each robot takes for mates rather than for walls: both
+    share (``give_way``) and the other still drives. Where a mate is the fleet shares; a
+    robot that arrived or crashed stands still and is a wall like any other."""
+    both = np.asarray(share, dtype=bool) & active
+    out = both[:, None] & both[None, :]
+    np.fill_diagonal(out, False)
+    return out
+
+
+def unmarked(share: Sequence[bool], active: np.ndarray, speed: np.ndarray,
+             waits: Iterable[tuple[int, int]]) -> np.ndarray:
+    """``[n, n]``: whose echoes each robot leaves off its map: its :func:`mates` that move
+    (:data:`MOVING` or faster), and the robot it waits on (``waits``: pairs of a robot and
+    the robot it gives way to) however it moves. Marked, a mate driving by was a trail of
+    walls where it had been, which the robot planned round: into a crossing's corner, or
+    swerving into the oncoming lane (six robots at a crossroads). A mate that stands, waiting
+    or giving way, is marked: it is in the way, and the route goes round it."""
+    out = mates(share, active) & (np.abs(speed) >= MOVING)[None, :]
+    for me, other in waits:
+        out[me, other] = True
+    return out
+
+
+def outlines(pose: np.ndarray, robots: Sequence[Robot], which: np.ndarray, half: float,
+             ahead: np.ndarray) -> list[np.ndarray]:
+    """Each robot's outline (``[P, 2]``; empty where not ``which``): the centres of squares
+    of half side ``half`` laid round its footprint at ``pose [n, 3]``, flush inside it and a
+    square's side apart, the footprint stretched ``ahead [n]`` in along its heading (backward
+    where negative): what another robot's brake counts for a mate, the room it takes to
+    stop (:meth:`.knowledge.RobotMap.brake_cells` counts the map's cells so)."""
+    out = []
+    for j, r in enumerate(robots):
+        if not which[j]:
+            out.append(np.zeros((0, 2)))
+            continue
+        a, b = max(r.length / 2 - half, 0.0), max(r.width / 2 - half, 0.0)
+        lo, hi = -a + min(float(ahead[j]), 0.0), a + max(float(ahead[j]), 0.0)
+        u = np.linspace(lo, hi, max(2, math.ceil((hi - lo) / (2 * half)) + 1))
+        v = np.linspace(-b, b, max(2, math.ceil(2 * b / (2 * half)) + 1))[1:-1]
+        local = np.concatenate([np.stack([u, np.full_like(u, -b)], 1),
+                                np.stack([u, np.full_like(u, b)], 1),
+                                np.stack([np.full_like(v, lo), v], 1),
+                                np.stack([np.full_like(v, hi), v], 1)])
+        x, y, h = pose[j]
+        c, s = math.cos(h), math.sin(h)
+        out.append(local @ np.array([[c, s], [-s, c]]) + (x, y))
+    return out
+
+
+def stopping(speed: np.ndarray, robots: Sequence[Robot], dt: float) -> np.ndarray:
+    """``[n]`` in: how far each robot drives (signed: backward negative) before it can
+    stop, a tick late: what a mate's footprint is stretched by for the brake
+    (:func:`bodies`), as each robot's brake stops it short of the others' so stretched."""
+    a = np.array([r.acceleration for r in robots])
+    return speed * (np.abs(speed) / (2 * a) + dt)
 
 
 def _unring(gives: list[dict[int, float]], room_of: Callable[[int, int], float]) -> None:
