@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from mitos_cli.engine.compile import compile_rulebase
 from mitos_cli.engine.evaluation import BLOCK, evaluate
+from mitos_cli.errors import NoRuleFiredError
 from mitos_cli.fuzzy import shapes
 from mitos_cli.lang.model import And, Consequent, Not, Or, Prop, Rule, format_rule
 from mitos_cli.lang.parse import parse_rule, parse_rules
@@ -358,3 +359,35 @@ def test_rule_file_round_trip(rule_list):
     text = "behavior b:\n" + "\n".join("    " + format_rule(r) for r in labelled) + "\nend\n"
     parsed = parse_rules(text)
     assert parsed.behaviors[0].rules == tuple(labelled)
+
+
+@settings(max_examples=300, deadline=None)
+@given(a=st.floats(-1e6, 1e6), width=st.floats(1e-6, 1e6), width2=st.floats(1e-6, 1e6))
+def test_the_kernel_gives_exactly_0_at_each_foot_of_a_linear_term(a, width, width2):
+    """``1 + (x - b) * s1`` at ``x = a`` was 1.1e-16 for about 15% of widths (the rounded
+    ``1 / (b - a)`` a hair short), so a rule fired where its term is 0: `eval` printed an
+    output for an input at the foot of a triangle where the shape says no rule fires. The
+    slopes are raised by the ulps it takes, no more than a few."""
+    b = a + width
+    d = b + width2
+    hypothesis_assume(b > a and d > b)
+    k_b, s1, k_c, s2 = shapes.kernel_params((a, b, b, d))
+    assert 1.0 + (a - k_b) * s1 <= 0.0
+    assert 1.0 + (k_c - d) * s2 <= 0.0
+    assert s1 >= 1.0 / (b - a) and s1 <= math.nextafter(1.0 / (b - a), math.inf) * (1 + 1e-15)
+    assert s2 >= 1.0 / (d - b) and s2 <= math.nextafter(1.0 / (d - b), math.inf) * (1 + 1e-15)
+
+
+def test_an_input_at_the_foot_of_a_triangle_fires_no_rule():
+    """A triangle 49 in each side ([0, 49, 98]) at x = 0 and x = 98: no rule fires, as the
+    shape says (its kernel had given DOF 1.1e-16 there, and `y = 5.0`)."""
+    terms = parse_termset("variables:\n"
+                          "  x:\n    role: input\n    universe: [0, 100]\n    terms:\n"
+                          "      A: {shape: triangle, points: [0, 49, 98]}\n"
+                          "  y:\n    role: output\n    universe: [0, 10]\n    terms:\n"
+                          "      B: {shape: triangle, points: [2, 5, 8]}\n", "f.terms.yaml")
+    rb = build_rulebase(parse_rules("r1: if x is A then y is B\n", "f.rules"), (terms,))
+    compiled = compile_rulebase(rb)
+    with pytest.raises(NoRuleFiredError, match=r"x=0 \(2 of 3 samples\)"):
+        evaluate(compiled, np.array([[0.0], [98.0], [1.0]]))
+    assert evaluate(compiled, np.array([[1.0]])).dof[0, 0] == pytest.approx(1 / 49)
