@@ -35,18 +35,21 @@ class Ran:
         self.output = out + err
 
 
+def run_compare(capsys, *args) -> Ran:
+    """``mitos compare ARGS`` in this process: exit code, stdout, stderr."""
+    try:
+        main(["compare", *map(str, args)])
+        code = 0
+    except SystemExit as exc:
+        code = exc.code or 0
+    out, err = capsys.readouterr()
+    return Ran(code, out, err)
+
+
 @pytest.fixture
 def compare(capsys):
-    """``mitos compare ARGS`` in this process: exit code, stdout, stderr."""
-    def run(*args) -> Ran:
-        try:
-            main(["compare", *map(str, args)])
-            code = 0
-        except SystemExit as exc:
-            code = exc.code or 0
-        out, err = capsys.readouterr()
-        return Ran(code, out, err)
-    return run
+    """:func:`run_compare` with this test's ``capsys``."""
+    return lambda *args: run_compare(capsys, *args)
 
 
 def read_rows(directory) -> list[dict]:

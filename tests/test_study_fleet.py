@@ -12,8 +12,8 @@ import shutil
 from pathlib import Path
 
 import pytest
+from test_study_cli import run_compare
 
-from mitos_cli.cli.app import main
 from mitos_cli.study import Study, make_choices, run_study
 from mitos_cli.study.store import COLUMNS, FLEET_COLUMNS, ResultStore, StudyError
 
@@ -24,13 +24,8 @@ GOLDEN = DATA / "compare_fleet_tiny"
 
 
 def compare(capsys, *args) -> tuple[int, str, str]:
-    try:
-        main(["compare", *map(str, args)])
-        code = 0
-    except SystemExit as exc:
-        code = exc.code or 0
-    out, err = capsys.readouterr()
-    return code, out, err
+    ran = run_compare(capsys, *args)
+    return ran.exit_code, ran.stdout, ran.stderr
 
 
 def _cells(text: str) -> list[list[object]]:
