@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mitos_cli.errors import WorldError
+from mitos_cli.resources import packaged_path
 from mitos_cli.sim import traffic
 from mitos_cli.sim.lockstep import run_lockstep
 from mitos_cli.sim.loop import STUCK_TIME, Simulation, prepare, simulate
@@ -277,16 +278,17 @@ def test_a_robot_leaves_off_its_map_the_mates_that_move_and_the_one_it_waits_on(
 @settings(max_examples=60, deadline=None)
 @given(heading=st.floats(-math.pi, math.pi), ahead=st.floats(-80, 80),
        half=st.sampled_from([1.0, 2.5, 5.0]))
-def test_a_mates_outline_lies_flush_inside_its_stretched_footprint_without_gaps(
+def test_a_mates_outline_covers_the_cells_round_its_stretched_footprint_without_gaps(
         heading, ahead, half):
     """The squares laid round a mate's footprint (stretched by the room it takes to stop)
-    lie inside it, reach its edges, and leave no gap a brake's sweep could pass through."""
+    cover the band a cell wide just outside it, as marks of its echoes would, and leave no
+    gap a brake's sweep could pass through."""
     pose = np.array([[10.0, -20.0, heading]])
     out = traffic.outlines(pose, [ROBOT], np.array([True]), half, np.array([ahead]))[0]
     c, s = math.cos(heading), math.sin(heading)
     rel = out - pose[0, :2]
     u, v = rel @ np.array([c, s]), rel @ np.array([-s, c])
-    a, b = ROBOT.length / 2 - half, ROBOT.width / 2 - half
+    a, b = ROBOT.length / 2 + half, ROBOT.width / 2 + half          # the squares' centres
     lo, hi = -a + min(ahead, 0.0), a + max(ahead, 0.0)
     assert (u >= lo - 1e-9).all() and (u <= hi + 1e-9).all()
     assert (np.abs(v) <= b + 1e-9).all()
@@ -342,3 +344,13 @@ def test_six_robots_that_drive_by_each_other_leave_no_trails_and_all_arrive():
     together = run_lockstep(world, planner, [1000, 1001], randomise=True, scene=scene)
     assert [res.robot_outcomes for res in together] == [("success",) * 6] * 2
     assert_same_run(simulate(world, planner, 1000, randomise=True, scene=scene), together[0])
+
+
+def test_a_robot_passing_a_mate_that_turns_as_it_stops_keeps_off_it():
+    """``multirobot`` seed 16: `robot` passed `oncoming` at a hair as `oncoming` turned and
+    stopped, and touched it (17.15 s) when its brake counted the mate's body flush inside
+    the footprint; counting the cells just outside it, as marks of its echoes would be, both
+    arrive."""
+    res = simulate(load_world(packaged_path("worlds", "multirobot.yaml")), seed=16,
+                   randomise=True)
+    assert res.robot_outcomes == ("success", "success")

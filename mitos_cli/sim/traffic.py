@@ -283,16 +283,19 @@ def unmarked(share: Sequence[bool], active: np.ndarray, speed: np.ndarray,
 def outlines(pose: np.ndarray, robots: Sequence[Robot], which: np.ndarray, half: float,
              ahead: np.ndarray) -> list[np.ndarray]:
     """Each robot's outline (``[P, 2]``; empty where not ``which``): the centres of squares
-    of half side ``half`` laid round its footprint at ``pose [n, 3]``, flush inside it and a
-    square's side apart, the footprint stretched ``ahead [n]`` in along its heading (backward
-    where negative): what another robot's brake counts for a mate, the room it takes to
-    stop (:meth:`.knowledge.RobotMap.brake_cells` counts the map's cells so)."""
+    of half side ``half`` (a cell of the maps) laid round its footprint at ``pose [n, 3]``,
+    a square's side apart, each covering the cell just outside the footprint as a mark covers
+    the cell beyond an echo; the footprint stretched ``ahead [n]`` in along its heading
+    (backward where negative). What another robot's brake counts for a mate, the room it
+    takes to stop (:meth:`.knowledge.RobotMap.brake_cells` counts the map's cells so). Flush
+    inside the footprint, a robot passing a mate that turned as it stopped touched it
+    (`multirobot` seed 16)."""
     out = []
     for j, r in enumerate(robots):
         if not which[j]:
             out.append(np.zeros((0, 2)))
             continue
-        a, b = max(r.length / 2 - half, 0.0), max(r.width / 2 - half, 0.0)
+        a, b = r.length / 2 + half, r.width / 2 + half
         lo, hi = -a + min(float(ahead[j]), 0.0), a + max(float(ahead[j]), 0.0)
         u = np.linspace(lo, hi, max(2, math.ceil((hi - lo) / (2 * half)) + 1))
         v = np.linspace(-b, b, max(2, math.ceil(2 * b / (2 * half)) + 1))[1:-1]
