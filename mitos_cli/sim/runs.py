@@ -71,49 +71,30 @@ def ignore_interrupts() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def end_with_parent(started_by_main_thread: bool) -> None:
+def end_with_parent() -> None:
     """A pool worker's initializer: end at once when the process that started the pool is
     gone. Nothing terminates the pool of a process killed (``kill -9``, the out-of-memory
     killer): its workers ran their chunks to the end, seconds, printing the tracebacks of
     the pipes they found broken, and held what they had inherited, the lock of a study's
     directory among them (a `--resume` at once was refused: "in use by another study").
 
-    Linux kills the worker with its parent (``PR_SET_PDEATHSIG``, asked for only when the
-    main thread starts the pool: it fires when the *thread* that forked the worker ends);
-    everywhere, a thread waits on the parent's sentinel (a pipe that the parent's end
-    closes) and ends the process.
+    A thread waits on the parent's sentinel (a pipe that the parent's end closes) and ends
+    the process: within milliseconds of the parent. Not Linux's ``PR_SET_PDEATHSIG``: it
+    fires when the *thread* that forked the worker ends, and the pool forks the workers that
+    replace lost ones from its own handler thread, which ends at ``terminate()``; a worker so
+    killed while it held the pool's task-queue lock hung ``terminate()`` for ever (a CI run,
+    ``test_a_streaming_pool_gives_every_part_as_made_and_raises_a_worker_s_error``).
     """
     import multiprocessing
     import threading
 
-    if started_by_main_thread:
-        _killed_with_parent()
     parent = multiprocessing.parent_process()
     if parent is None:                  # (not a worker of multiprocessing's)
         return
-    if not parent.is_alive():           # gone before the kernel was asked
+    if not parent.is_alive():           # gone before the thread could wait
         os._exit(1)
     threading.Thread(target=_end_when_gone, args=(parent,), name="mitos-parent-watch",
                      daemon=True).start()
-
-
-def _killed_with_parent() -> None:
-    """Ask Linux for a SIGKILL when the parent goes (``prctl(PR_SET_PDEATHSIG)``); nothing
-    elsewhere, or where the C library does not answer."""
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-    import signal
-
-    pr_set_pdeathsig = 1                # (linux/prctl.h)
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(pr_set_pdeathsig, ctypes.c_ulong(signal.SIGKILL), ctypes.c_ulong(0),
-                   ctypes.c_ulong(0), ctypes.c_ulong(0))
-    except (OSError, AttributeError):
-        pass
 
 
 def _end_when_gone(parent: BaseProcess) -> None:
@@ -372,10 +353,10 @@ def even_chunks(n: int, workers: int, most: int) -> int:
 _outbox: Any = None
 
 
-def _streaming_worker(outbox: Queue, started_by_main_thread: bool) -> None:
+def _streaming_worker(outbox: Queue) -> None:
     global _outbox
     ignore_interrupts()
-    end_with_parent(started_by_main_thread)
+    end_with_parent()
     _outbox = outbox
 
 
@@ -406,13 +387,11 @@ def pool_streaming(fn: Callable[[Any], Iterator[Any]], items: list,
     import multiprocessing
     import pickle
     import queue
-    import threading
 
     context = multiprocessing.get_context()
     outbox = context.Queue()
     others = {p.pid for p in multiprocessing.active_children()}
-    main = threading.current_thread() is threading.main_thread()
-    pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox, main))
+    pool = context.Pool(workers, initializer=_streaming_worker, initargs=(outbox,))
     started = {p.pid for p in multiprocessing.active_children()} - others
     finished = False
     try:
