@@ -1173,9 +1173,9 @@ class Simulation:
         if self._bodies_at[:2] != (self._k, half):
             share = traffic.mates(self._traffic, active)
             stretch = traffic.stopping(speed, self.robots, self.dt)
+            shared = np.asarray(share.any(axis=0))
             self._bodies_at = (self._k, half, share,
-                               traffic.outlines(pose, self.robots, np.asarray(share.any(axis=0)), half,
-                                                stretch))
+                               traffic.outlines(pose, self.robots, shared, half, stretch))
         share, outlines = self._bodies_at[2:]
         of = share[i].nonzero()[0].tolist()
         if not of:

@@ -312,7 +312,7 @@ def outlines(pose: np.ndarray, robots: Sequence[Robot], which: np.ndarray, half:
 def stopping(speed: np.ndarray, robots: Sequence[Robot], dt: float) -> np.ndarray:
     """``[n]`` in: how far each robot drives (signed: backward negative) before it can
     stop, a tick late: what a mate's footprint is stretched by for the brake
-    (:func:`bodies`), as each robot's brake stops it short of the others' so stretched."""
+    (:func:`outlines`), as each robot's brake stops it short of the others' so stretched."""
     a = np.array([r.acceleration for r in robots])
     return speed * (np.abs(speed) / (2 * a) + dt)
 
