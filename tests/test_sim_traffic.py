@@ -15,11 +15,12 @@ from hypothesis import strategies as st
 from mitos_cli.errors import WorldError
 from mitos_cli.resources import packaged_path
 from mitos_cli.sim import traffic
+from mitos_cli.sim.knowledge import RobotMap
 from mitos_cli.sim.lockstep import run_lockstep
 from mitos_cli.sim.loop import STUCK_TIME, Simulation, prepare, simulate
 from mitos_cli.sim.planner import FuzzyPlanner
 from mitos_cli.sim.route import Route
-from mitos_cli.sim.world import Robot
+from mitos_cli.sim.world import Grid, Robot
 from mitos_cli.sim.worldfile import load_world
 
 DATA = Path(__file__).parent / "data"
@@ -354,3 +355,98 @@ def test_a_robot_passing_a_mate_that_turns_as_it_stops_keeps_off_it():
     res = simulate(load_world(packaged_path("worlds", "multirobot.yaml")), seed=16,
                    randomise=True)
     assert res.robot_outcomes == ("success", "success")
+
+
+def corridor_map(box: tuple[float, float, float, float] | None = None) -> RobotMap:
+    """A robot's map of a corridor 90 in wide along x from 0 to 800 (cells of 2 in), with
+    the cells of ``box`` (x0, x1, y0, y1) marked as a robot marks what it sensed."""
+    res, origin = 2.0, (-10.0, -60.0)
+    xs = origin[0] + (np.arange(420) + 0.5) * res
+    ys = origin[1] + (np.arange(60) + 0.5) * res
+    x, y = np.meshgrid(xs, ys)
+    rmap = RobotMap.of(Grid(np.abs(y) > 45, res, origin))
+    if box is not None:
+        x0, x1, y0, y1 = box
+        inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
+        rmap.mark_cells(np.stack([inside.nonzero()[1], inside.nonzero()[0]], axis=1))
+    return rmap
+
+
+def on_map(x: float, y: float, heading_deg: float, rmap: RobotMap,
+           speed: float = 30.0) -> traffic.Mate:
+    """:func:`driving`, with the robot's map."""
+    m = driving(x, y, heading_deg, speed)
+    return traffic.Mate(m.route, m.progress, x, y, speed, ROBOT, rmap)
+
+
+#: boxes on the south side of the corridor leave 40 in of it (two side by side need 44)
+BOXES = (360.0, 440.0, -45.0, 5.0)
+
+
+def test_the_room_across_a_path_is_measured_on_the_robots_map():
+    path = np.stack([np.arange(0.0, 800.0, 4.0), np.full(200, 25.0)], axis=1)
+    width, middle = traffic.across(corridor_map(BOXES), path, np.array([50, 100]), 44.0)
+    # at x = 200 the corridor (wall to wall; each side at most 44), at x = 400 the room
+    # between the boxes and the wall, in whole cells as the map marches its beams
+    assert width.tolist() == pytest.approx([20 + 44, 40], abs=2.0)
+    assert middle[1, 1] == pytest.approx(25.0, abs=1.0)
+
+
+def test_head_on_where_boxes_leave_room_for_one_the_robot_with_them_on_its_side_waits():
+    """The rule of the road: give way where the obstruction is on your side. The boxes are
+    on the eastbound's side, its route (not yet planned round them) running into them."""
+    rmap = corridor_map(BOXES)
+    east, west = on_map(200, -15, 0, rmap), on_map(600, 15, 180, rmap)
+    c = traffic.crossing(east, west)
+    assert c is not None and c.narrow and c.right          # the room is on west's side
+    assert waits(east, west) == [(0, 1)]
+    assert waits(west, east) == [(1, 0)]                   # in the other order, the same
+    # boxes on the north side: the westbound waits
+    north = corridor_map((360.0, 440.0, -5.0, 45.0))
+    assert waits(on_map(200, -15, 0, north), on_map(600, 15, 180, north)) == [(1, 0)]
+    # (its route running on in its lane, it drives on: it waits where its route would take
+    # it into the other's way, below)
+    assert limits(east, west).tolist() == [math.inf, math.inf]
+
+
+def waits(*mates: traffic.Mate) -> list[tuple[int, int]]:
+    ways = traffic.Traffic()
+    ways.limits(list(mates), DT)
+    return ways.waits
+
+
+def test_head_on_in_a_corridor_with_room_for_two_is_no_crossing():
+    wide = corridor_map((360.0, 440.0, -45.0, -30.0))       # 75 in left
+    assert traffic.crossing(on_map(200, -15, 0, wide), on_map(600, 15, 180, wide)) is None
+    assert traffic.crossing(on_map(200, -15, 0, corridor_map()),
+                            on_map(600, 15, 180, corridor_map())) is None
+
+
+def test_a_robot_giving_way_at_a_narrow_place_waits_in_its_lane_short_of_the_others_way():
+    rmap = corridor_map(BOXES)
+    bend = Route.of([(150, -15), (330, -15), (360, 25), (440, 25), (470, -15), (800, -15)])
+    east = traffic.Mate(bend, 50.0, 200, -15, 30.0, ROBOT, rmap)
+    west = on_map(560, 25, 180, rmap)
+    # east's route comes within a lane (22 in) of west's, at y = 25, on its way up to the
+    # room by the boxes, 152.5 in on (its places 4 in apart: the first within, 156 in): its
+    # front stops SLACK short of there
+    room = traffic.room_beside(east, west)
+    assert room == 156 - 2 * 12 - traffic.SLACK
+    assert waits(east, west) == [(0, 1)]
+    assert limits(east, west)[0] == math.sqrt((40 * DT) ** 2 + 2 * 40 * room) - 40 * DT
+    west_gone = on_map(100, 25, 180, rmap)                 # west passed it: its way is clear
+    assert traffic.room_beside(east, west_gone) == math.inf
+
+
+def test_two_robots_head_on_where_boxes_leave_room_for_one_pass_in_turn():
+    """``narrow_pass`` seeds 1001 and 1007: both robots made for the room by the boxes,
+    braked face to face and backed away in turn (one stuck after 54.50 s, both timed out).
+    Now the robot with the boxes on its side waits in its lane and both arrive, alike alone
+    and in a batch."""
+    from test_sim_lockstep import assert_same_run
+
+    world = load_world(DATA / "traffic" / "narrow_pass.yaml")
+    planner, scene = FuzzyPlanner(None, world.behavior), prepare(world)
+    together = run_lockstep(world, planner, [1001, 1007], randomise=True, scene=scene)
+    assert [res.robot_outcomes for res in together] == [("success", "success")] * 2
+    assert_same_run(simulate(world, planner, 1007, randomise=True, scene=scene), together[1])

@@ -1395,7 +1395,7 @@ class Simulation:
         (:mod:`.traffic`), from the robots' ``active``, place (``x``, ``y``), ``speed`` and
         route ``progress``."""
         mates = [traffic.Mate(self._routes[i], float(progress[i]), float(x[i]), float(y[i]),
-                              float(speed[i]), r) if share and active[i] else None
+                              float(speed[i]), r, self._maps[i]) if share and active[i] else None
                  for i, (r, share) in enumerate(zip(self.robots, self._traffic))]
         limit = self._ways.limits(mates, self.dt)
         held = limit < command[:, 1]

@@ -25,6 +25,13 @@ manager), and give way by the rule of the road:
   already inside stops where it is. It goes on once the other's route, rear included, has
   left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`), and it leaves
   the echoes of the robot it waits on out of its tracks;
+- a **narrow place**: two robots coming towards each other where both routes pass a place
+  with room for one (:func:`narrow`: across either robot's route on its map, less than the
+  two side by side with their margins; the place is often seen only once they have met)
+  cross there in turn: the one with the obstruction on its side gives way (whoever comes
+  to the place first), unless only it is committed. It waits in its lane, short of where
+  its route comes within a lane of the other's (:func:`room_beside`). Head-on where there
+  is room for two they pass each other as before;
 - **mates are not walls**: a robot leaves off its map the echoes (:func:`echoes`) of the
   robots of its fleet that drive by, and of the one it waits on (:func:`unmarked`); its
   brake counts their bodies instead, each stretched by the room it takes to stop
@@ -46,6 +53,7 @@ from typing import cast
 
 import numpy as np
 
+from .knowledge import RobotMap
 from .route import Route
 from .safety import brake
 from .world import Robot
@@ -77,17 +85,20 @@ LANE = 25.0
 
 
 class Mate:
-    """What a robot shares with the others of its run: where it is, its speed, and the
-    route it follows (the stretch ahead made only when a crossing is looked for)."""
+    """What a robot shares with the others of its run: where it is, its speed, the route it
+    follows (the stretch ahead made only when a crossing is looked for) and, where it has one,
+    its map (where two robots meeting head-on find room for one only, :func:`narrow`)."""
 
     def __init__(self, route: Route, progress: float, x: float, y: float, speed: float,
-                 robot: Robot) -> None:
+                 robot: Robot, rmap: RobotMap | None = None) -> None:
         self.route, self.progress, self.speed = route, progress, speed
         self.at = np.array([x, y])
         self.acceleration = robot.acceleration
         self.radius = math.hypot(robot.length / 2, robot.width / 2)
         self.back = robot.length / 2               # in: the path begins at its rear
+        self.lane = robot.width + 2 * robot.safety_margin    # in: the width it drives in
         self.reach = max(robot.max_speed, SLOWEST) * LOOK_TIME
+        self.map = rmap
         self._path: np.ndarray | None = None
 
     def ends(self, k: int) -> bool:
@@ -99,10 +110,13 @@ class Mate:
     def path(self) -> np.ndarray:
         """``[K, 2]`` its route from its rear to :attr:`reach` ahead, a place every STEP in."""
         if self._path is None:
-            ahead = np.arange(-self.back, self.reach + STEP / 2, STEP)
-            self._path = self.route.points_at(np.clip(self.progress + ahead, 0.0,
-                                                      self.route.length))
+            self._path = self.ahead(self.reach)
         return self._path
+
+    def ahead(self, span: float) -> np.ndarray:
+        """``[K, 2]`` its route from its rear to ``span`` ahead, a place every STEP in."""
+        ahead = np.arange(-self.back, span + STEP / 2, STEP)
+        return self.route.points_at(np.clip(self.progress + ahead, 0.0, self.route.length))
 
 
 def zone(a: Mate, b: Mate) -> float:
@@ -121,9 +135,10 @@ class Crossing:
     leave: tuple[float, float]
     centre: tuple[float, float]
     right: bool                    # the second robot comes from the first's right
+    narrow: bool = False           # head-on through a place with room for one (:func:`narrow`)
 
 
-def crossing(a: Mate, b: Mate, known: bool = False) -> Crossing | None:
+def crossing(a: Mate, b: Mate, known: bool = False, look_narrow: bool = True) -> Crossing | None:
     """Where the routes of ``a`` and ``b`` cross ahead, or ``None``: apart, or, unless the
     crossing is ``known`` already, with either robot backing out, with a route ending within
     :func:`zone` of the other (where the robot will stand: its goal, or a refuge out of a
@@ -131,7 +146,9 @@ def crossing(a: Mate, b: Mate, known: bool = False) -> Crossing | None:
     its first place there to its last) at less than :data:`CROSSING` to each other: head-on
     or one behind the other, where the stretches run along each other, even where one route
     swerves round an object for a moment. A known crossing is kept however the routes meet
-    (the routes of two robots going round each other in it may run side by side)."""
+    (the routes of two robots going round each other in it may run side by side). Robots
+    coming towards each other (``look_narrow``, known or not) cross where both pass a place
+    with room for one (:func:`narrow`): the place is often seen only once they have met."""
     if math.dist(a.at, b.at) > a.back + a.reach + b.back + b.reach + zone(a, b):
         return None                                   # (too far apart for their paths to)
     if not known and min(a.speed, b.speed) < 0:
@@ -141,14 +158,96 @@ def crossing(a: Mate, b: Mate, known: bool = False) -> Crossing | None:
     rows, cols = near.any(axis=1).nonzero()[0], near.any(axis=0).nonzero()[0]
     if not len(rows):
         return None
-    sine = _sine(_unit(a.path[rows[-1]] - a.path[rows[0]]),
-                 _unit(b.path[cols[-1]] - b.path[cols[0]]))
-    if not known and (abs(sine) < CROSSING or a.ends(rows[-1]) or b.ends(cols[-1])):
+    ua, ub = _unit(a.path[rows[-1]] - a.path[rows[0]]), _unit(b.path[cols[-1]] - b.path[cols[0]])
+    sine = _sine(ua, ub)
+    if not known and (a.ends(rows[-1]) or b.ends(cols[-1])):
+        return None
+    if look_narrow and _cosine(ua, ub) < 0 and (tight := narrow(a, b)) is not None:
+        return tight
+    if not known and abs(sine) < CROSSING:
         return None
     i, j = (int(k) for k in np.unravel_index(int(np.argmin(d)), d.shape))
     return Crossing((rows[0] * STEP - a.back, cols[0] * STEP - b.back),
                     (rows[-1] * STEP - a.back, cols[-1] * STEP - b.back),
                     (i * STEP - a.back, j * STEP - b.back), sine > 0)
+
+
+def narrow(a: Mate, b: Mate) -> Crossing | None:
+    """Where ``a`` and ``b``, coming towards each other, both pass a place too narrow for the
+    two side by side (:func:`across` under the sum of their :attr:`Mate.lane`), as a
+    :class:`Crossing` from the first such place of each one's route to the last, or
+    ``None``; ``right`` if the room is on ``b``'s side. The routes are looked along until
+    each has passed the other robot (the place is seen late, and each sees only its own
+    side of it); a place is narrow on either robot's map, and a place of one route is in
+    the narrow where it lies within :func:`zone` of a narrow place of the other (the one
+    seen is often not on the other's route yet: it runs on where it has not seen it)."""
+    if a.map is None or b.map is None:
+        return None
+    span = math.dist(a.at, b.at) + zone(a, b)
+    pa, pb = a.ahead(span), b.ahead(span)
+    d = np.hypot(pa[:, None, 0] - pb[None, :, 0], pa[:, None, 1] - pb[None, :, 1])
+    near = d < zone(a, b)
+    rows, cols = near.any(axis=1).nonzero()[0], near.any(axis=0).nonzero()[0]
+    if not len(rows):
+        return None
+    need = a.lane + b.lane
+    (wa, ma), (wb, mb) = across(a.map, pa, rows, need), across(b.map, pb, cols, need)
+    na, nb = wa < need, wb < need
+    if not (na.any() or nb.any()):
+        return None
+    apart = d[np.ix_(rows, cols)] < zone(a, b)
+    in_a, in_b = na | apart[:, nb].any(axis=1), nb | apart[na, :].any(axis=0)
+    if not (in_a.any() and in_b.any()):
+        return None
+    ia, ib = rows[in_a], cols[in_b]
+    mid_a, mid_b = (ia[0] + ia[-1]) // 2, (ib[0] + ib[-1]) // 2
+    # the middle of the room, where a route runs in it (not through what it has not seen)
+    room_at = np.concatenate([ma[na & (wa >= a.lane / 2)], mb[nb & (wb >= b.lane / 2)]])
+    middle = room_at.mean(axis=0) if len(room_at) else (pa[mid_a] + pb[mid_b]) / 2
+    return Crossing((ia[0] * STEP - a.back, ib[0] * STEP - b.back),
+                    (ia[-1] * STEP - a.back, ib[-1] * STEP - b.back),
+                    (mid_a * STEP - a.back, mid_b * STEP - b.back),
+                    _left(a, b, middle) > 0, narrow=True)
+
+
+def _left(a: Mate, b: Mate, p: np.ndarray) -> float:
+    """How far (in) ``p`` lies to the left of ``a``'s way towards ``b`` (as far as it lies
+    to the right of ``b``'s towards ``a``): the room of a narrow place on a robot's left is
+    the oncoming lane for it, and the obstruction is on its own side (the rule of the road:
+    it gives way)."""
+    e = _unit(b.at - a.at)
+    return 0.0 if e is None else float(e[0] * (p[1] - a.at[1]) - e[1] * (p[0] - a.at[0]))
+
+
+def across(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
+           cap: float) -> tuple[np.ndarray, np.ndarray]:
+    """The room across ``path [K, 2]`` at its ``places`` on ``rmap``, to either side at
+    right angles to the path (each side at most ``cap``): its width ``[P]`` (``inf`` where
+    the path has no direction: its route's end) and its middle ``[P, 2]``. Each side is the
+    nearer of two beams a quarter of a STEP before and after the place: between them they
+    cross every cell the path passes (a face seen edge on is a cell or two thick)."""
+    along = np.gradient(path, axis=0)[places]
+    length = np.hypot(along[:, 0], along[:, 1])
+    ok = length > 1e-9
+    unit = np.zeros_like(along)
+    unit[ok] = along[ok] / length[ok, None]
+    left = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    at = path[places]
+    origins = np.concatenate([at - unit * (STEP / 4), at + unit * (STEP / 4)] * 2)
+    n = len(places)
+    sides = rmap.ranges(origins, np.concatenate([left, left, -left, -left]), cap)
+    to_left = np.minimum(sides[:n], sides[n:2 * n])
+    to_right = np.minimum(sides[2 * n:3 * n], sides[3 * n:])
+    width = to_left + to_right
+    width[~ok] = np.inf
+    return width, at + left * ((to_left - to_right) / 2)[:, None]
+
+
+def _cosine(u: np.ndarray | None, v: np.ndarray | None) -> float:
+    """The cosine of the angle between unit vectors ``u`` and ``v`` (0 where either is ``None``)."""
+    if u is None or v is None:
+        return 0.0
+    return float(u[0] * v[0] + u[1] * v[1])
 
 
 def _sine(u: np.ndarray | None, v: np.ndarray | None) -> float:
@@ -176,17 +275,38 @@ def _time(m: Mate, distance: float) -> float:
 def first(a: Mate, b: Mate, c: Crossing, dt: float) -> bool:
     """Whether ``a`` goes first at its crossing ``c`` with ``b``, decided where the two first
     meet it: a committed robot goes first; of two, the one that comes first to where their
-    routes meet (the one from the right at a tie); of none, the one from the other's right,
-    unless the other clears the crossing :data:`CLEAR_BY` before it arrives."""
+    routes meet (the one from the right at a tie); of none, at a :func:`narrow` place the one
+    with the room on its own side (the other has the obstruction on its side: the rule of
+    the road; ``a`` at a tie), elsewhere the one from the other's right, unless the other
+    clears the crossing :data:`CLEAR_BY` before it arrives."""
     mine, theirs = committed(a, c.enter[0], dt), committed(b, c.enter[1], dt)
     if mine != theirs:
         return mine
     if mine:
         ta, tb = _time(a, c.centre[0]), _time(b, c.centre[1])
         return ta < tb or (ta == tb and not c.right)
+    if c.narrow:               # the room on b's side: b goes (whoever comes to it first)
+        return not c.right
     if c.right:                                     # b from a's right: b goes, unless a is
         return _time(a, c.leave[0]) + CLEAR_BY <= _time(b, c.enter[1])     # gone by then
     return not _time(b, c.leave[1]) + CLEAR_BY <= _time(a, c.enter[0])
+
+
+def room_beside(a: Mate, b: Mate) -> float:
+    """How far (in) ``a``, giving way to ``b`` at a :func:`narrow` place, may still drive:
+    until its front is :data:`SLACK` short of where its route comes within a lane (half of
+    each one's :attr:`Mate.lane`) of ``b``'s, looked along until ``b`` has passed it. It
+    waits in its lane, out of the way ``b`` takes through the narrow and out of it; the
+    narrow's ends are not its marks (each robot sees only its own side of the place)."""
+    span = math.dist(a.at, b.at) + zone(a, b)
+    pa, pb = a.ahead(span), b.ahead(span)
+    gap = np.min(np.hypot(pa[:, None, 0] - pb[None, :, 0], pa[:, None, 1] - pb[None, :, 1]),
+                 axis=1)
+    ahead = np.arange(len(pa)) * STEP - a.back               # from its centre, along its route
+    inside = ((gap < (a.lane + b.lane) / 2) & (ahead >= 0)).nonzero()[0]
+    if not len(inside):
+        return math.inf
+    return max(float(ahead[inside[0]]) - 2 * a.back - SLACK, 0.0)
 
 
 def room(a: Mate, b: Mate) -> float:
@@ -206,6 +326,7 @@ class Traffic:
     def __init__(self) -> None:
         self.order: dict[tuple[int, int], int] = {}     # (i, j), i < j -> the one first
         self.waits: list[tuple[int, int]] = []          # (robot, the robot it waits on)
+        self.narrows: set[tuple[int, int]] = set()      # (i, j) met at a narrow place
 
     def limits(self, mates: Sequence[Mate | None], dt: float) -> np.ndarray:
         """Each robot's speed limit (in/s; ``inf`` where it gives way to none) among
@@ -217,17 +338,21 @@ class Traffic:
         for i in range(n):
             for j in range(i + 1, n):
                 a, b = mates[i], mates[j]
-                c = None if a is None or b is None else crossing(a, b, (i, j) in self.order)
+                c = None if a is None or b is None else \
+                    crossing(a, b, (i, j) in self.order, (i, j) not in self.narrows)
                 if c is None or a is None or b is None:
                     self.order.pop((i, j), None)
+                    self.narrows.discard((i, j))
                     continue
-                if (i, j) not in self.order:
+                if (i, j) not in self.order or c.narrow:   # (a crossing found narrow: anew)
                     self.order[i, j] = i if first(a, b, c, dt) else j
+                    if c.narrow:
+                        self.narrows.add((i, j))
                 if self.order[i, j] == i:
-                    gives[j][i] = room(b, a)
+                    gives[j][i] = self._room(mates, j, i)
                 else:
-                    gives[i][j] = room(a, b)
-        _unring(gives, lambda i, j: room(cast(Mate, mates[i]), cast(Mate, mates[j])))
+                    gives[i][j] = self._room(mates, i, j)
+        _unring(gives, lambda i, j: self._room(mates, i, j))
         self.waits = [(i, j) for i, given in enumerate(gives) for j in given]
         out = np.full(n, np.inf)
         for i, given in enumerate(gives):
@@ -235,6 +360,14 @@ class Traffic:
             if m is not None and given:
                 out[i] = brake(min(given.values()), m.acceleration, 0.0, dt)
         return out
+
+    def _room(self, mates: Sequence[Mate | None], i: int, j: int) -> float:
+        """Robot ``i``'s room giving way to ``j``: short of the narrow place where the two
+        met head-on (:func:`room_beside`), else outside the crossing (:func:`room`)."""
+        a, b = cast(Mate, mates[i]), cast(Mate, mates[j])
+        if (min(i, j), max(i, j)) in self.narrows:
+            return room_beside(a, b)
+        return room(a, b)
 
 
 def echoes(pose: np.ndarray, robots: Sequence[Robot], ranges: np.ndarray,
