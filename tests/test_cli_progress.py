@@ -532,9 +532,10 @@ def test_a_hangup_stops_compare_as_a_sigterm_does(tmp_path, sig, code):
     try:
         deadline = time.monotonic() + 30
         while time.monotonic() < deadline and proc.poll() is None:
-            if (out / "results.csv").exists():      # the study has begun
+            if (out / "results.csv").exists():      # the study begins (its count follows)
                 break
             time.sleep(0.01)
+        time.sleep(0.2)
         proc.send_signal(getattr(signal, sig))
         _, err = proc.communicate(timeout=30)
     finally:
