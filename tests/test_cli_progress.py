@@ -354,3 +354,192 @@ def test_ctrl_c_in_a_single_run_says_so(capsys, monkeypatch, tmp_path):
     assert code == 130 and out == ""
     assert err.strip() == "interrupted before the run ended: nothing written"
     assert not (tmp_path / "t.csv").exists()
+
+
+#: Runs ``mitos ARGS...`` (``python -c DRIVER OUT SIGNAL HOOK ARGS...``) and sends this process
+#: the signal SIGNAL at a place HOOK names, so that a test does not depend on how fast the
+#: machine runs: ``run`` once the first run of ``--runs`` has finished (the pool's worker
+#: processes written to OUT), ``tick`` at the 10th tick of a single run, ``draw`` as its
+#: picture is drawn (after the CSV is written). SIGNAL ``WAIT`` sends none: it waits there
+#: for one from outside.
+SIGNAL_DRIVER = """
+import multiprocessing, os, signal, sys
+from pathlib import Path
+
+from mitos_cli.cli.app import main
+from mitos_cli.draw import world as draw_world
+from mitos_cli.sim import loop, runs
+
+out, sig, hook = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+execute, simulate, draw_run = runs._execute, loop.simulate, draw_world.draw_run
+
+def stop():
+    if sig == "WAIT":
+        signal.pause()
+    else:
+        os.kill(os.getpid(), getattr(signal, sig))
+
+def stopped_after_the_first_run(jobs, workers):
+    for part in execute(jobs, workers):
+        yield part
+        if len(part) == 3:                       # a run's summary (not a clock)
+            out.write_text(" ".join(str(p.pid) for p in multiprocessing.active_children()))
+            stop()
+
+def stopped_at_tick_10(*args, **kwargs):
+    ticks = []
+    def tick(*a, **k):
+        ticks.append(1)
+        if len(ticks) == 10:
+            stop()
+    return simulate(*args, **{**kwargs, "on_tick": tick})
+
+def stopped_drawing(*args, **kwargs):
+    stop()
+    return draw_run(*args, **kwargs)
+
+if hook == "run":
+    runs._execute = stopped_after_the_first_run
+elif hook == "tick":
+    loop.simulate = stopped_at_tick_10
+elif hook == "draw":
+    draw_world.draw_run = stopped_drawing
+sys.argv = ["mitos", *sys.argv[4:]]
+main()
+"""
+
+
+def _signalled(tmp_path: Path, sig: str, hook: str, *args: object) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-c", SIGNAL_DRIVER, str(tmp_path / "pids"), sig, hook,
+                           *map(str, args)], env=env, cwd=tmp_path, capture_output=True,
+                          text=True, timeout=60)
+
+
+def _alive(pids: list[int]) -> list[int]:
+    """Those of ``pids`` still running (not ended, nor a zombie)."""
+    alive = []
+    for pid in pids:
+        try:
+            if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z":
+                alive.append(pid)
+        except (OSError, IndexError):
+            pass
+    return alive
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in /proc")
+@pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGHUP", 129), ("SIGINT", 130)])
+def test_a_signal_stops_simulate_runs_as_ctrl_c_does(tmp_path, sig, code):
+    """`simulate --runs` on a SIGTERM (`kill PID`, a scheduler's time limit) or a SIGHUP (the
+    terminal closed) ended without a word, the finished runs lost (exit -15, -1). It stops
+    as on Ctrl-C now: the table of the runs that had finished, the same words, the
+    workers gone at once; exit 143, 129 (128 + the signal, as a shell says it)."""
+    proc = _signalled(tmp_path, sig, "run", "simulate", TINY, "--runs", 40, "-j", 2)
+    assert proc.returncode == code, proc.stderr
+    gone = time.monotonic() + 1.0
+    workers = [int(p) for p in (tmp_path / "pids").read_text().split()]
+    while _alive(workers) and time.monotonic() < gone:
+        time.sleep(0.01)
+    assert len(workers) == 2 and not _alive(workers), "the workers ran on"
+    table = proc.stdout.splitlines()
+    assert table[0].split()[:2] == ["world", "runs"] and table[1].split()[0] == "tiny"
+    done = int(table[1].split()[1])
+    assert 1 <= done < 40
+    assert proc.stderr == (f"interrupted: the table has the {done} of 40 runs that had "
+                           f"finished (their seeds: runs_detail in --json)\n")
+
+
+@pytest.mark.skipif(not hasattr(os, "openpty") or not Path("/proc/self/stat").exists(),
+                    reason="a pseudo-terminal; finds the workers in /proc")
+@pytest.mark.parametrize("log", [True, False], ids=["stderr-to-a-file", "stderr-on-it"])
+def test_a_closed_terminal_stops_simulate_runs_cleanly(tmp_path, log):
+    """The terminal `simulate --runs` runs on is closed (the window, an ssh session): its
+    SIGHUP ended the command at once (exit -1), and, answered, every write to the terminal
+    gone failed (EIO), so that the stop ended in "cannot write the output: Input/output
+    error" and exit 1. It stops with exit 129 now, the words in a log that stderr goes to."""
+    import select
+
+    master, slave = os.openpty()
+    name = os.ttyname(slave)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    errors = open(tmp_path / "err.txt", "w") if log else slave     # noqa: SIM115
+    proc = subprocess.Popen(
+        [sys.executable, "-c", SIGNAL_DRIVER, str(tmp_path / "pids"), "WAIT", "run",
+         "simulate", str(TINY), "--runs", "40", "-j", "2"], env=env, cwd=tmp_path,
+        stdin=slave, stdout=slave, stderr=errors, start_new_session=True,
+        # its controlling terminal, which hangs up when the master closes
+        preexec_fn=lambda: os.close(os.open(name, os.O_RDWR)))
+    os.close(slave)
+    if log:
+        errors.close()
+    try:
+        deadline = time.monotonic() + 30
+        while not (tmp_path / "pids").exists() and time.monotonic() < deadline:
+            if select.select([master], [], [], 0.05)[0]:
+                os.read(master, 65536)                  # (a full terminal would block it)
+        assert (tmp_path / "pids").exists(), "no run finished"
+        os.close(master)                                # the terminal closes
+        code = proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    workers = [int(p) for p in (tmp_path / "pids").read_text().split()]
+    gone = time.monotonic() + 1.0
+    while _alive(workers) and time.monotonic() < gone:
+        time.sleep(0.01)
+    assert code == 129 and not _alive(workers)
+    if log:
+        said = (tmp_path / "err.txt").read_text()
+        assert said.startswith("interrupted: the table has the ") and said.endswith(
+            " of 40 runs that had finished (their seeds: runs_detail in --json)\n"), said
+
+
+@pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGHUP", 129)])
+def test_a_signal_stops_a_single_run_writing_nothing(tmp_path, sig, code):
+    """One run (`simulate WORLD --out --plot --trace`) on a SIGTERM ended without a word;
+    now as on Ctrl-C: nothing written, nothing left half-written beside the targets."""
+    proc = _signalled(tmp_path, sig, "tick", "simulate", TINY, "--trace", "--out", "t.csv",
+                      "--plot", "t.png")
+    assert proc.returncode == code, proc.stderr
+    assert proc.stdout == ""
+    assert proc.stderr == "interrupted before the run ended: nothing written\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sigterm_while_the_files_are_written_says_which_are(tmp_path):
+    """A SIGTERM as the picture is drawn: the CSV written whole, no picture and no temporary
+    file beside it (saves are atomic, and the one going is removed), said; exit 143."""
+    pytest.importorskip("matplotlib")
+    proc = _signalled(tmp_path, "SIGTERM", "draw", "simulate", TINY, "--out", "t.csv",
+                      "--plot", "t.png")
+    assert proc.returncode == 143, proc.stderr
+    assert proc.stderr == "interrupted: wrote the ticks to t.csv; the rest is not written\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+    assert proc.stdout == ""
+
+
+@pytest.mark.parametrize("sig, code", [("SIGHUP", 129), ("SIGTERM", 143)])
+def test_a_hangup_stops_compare_as_a_sigterm_does(tmp_path, sig, code):
+    """A closed terminal's SIGHUP ended `compare` without a word (exit -1), where a SIGTERM
+    said what was kept and how to go on: both do now (exit 129, 143)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    out = tmp_path / "s"
+    proc = subprocess.Popen([sys.executable, "-m", "mitos_cli", "compare", str(TINY), "--and",
+                             "min", "--planner", "fuzzy", "--runs", "40", "-j", "1", "-o",
+                             str(out), "--no-plots"], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and proc.poll() is None:
+            if (out / "results.csv").exists():      # the study begins (its count follows)
+                break
+            time.sleep(0.01)
+        time.sleep(0.2)
+        proc.send_signal(getattr(signal, sig))
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == code, err
+    assert f"runs kept in {out / 'results.csv'}" in err and err.rstrip().endswith("--resume")

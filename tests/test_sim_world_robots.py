@@ -192,22 +192,52 @@ def test_the_command_refuses_a_misplaced_give_way_with_exit_1(tmp_path, capsys):
         "as `robot: {give_way: false}`\n")
 
 
+def goals(first: str, b: str) -> str:
+    """The world with the first robot's goal and `b`'s (`{x: ..., y: ...}`) as given."""
+    return world().replace("q_goal: {x: 570, y: -10}", f"q_goal: {first}").replace(
+        "q_goal: {x: 30, y: 10}", f"q_goal: {b}")
+
+
 def test_two_goals_no_two_bodies_can_stand_at_are_refused():
     """`b`'s goal on the first robot's with a tolerance of 1 in (the first's 12): whichever
     arrived first parked in the other's way, and the run drove on to its time limit
-    (`TIMEOUT (robot timeout, b success) after 60.00 s`)."""
-    text = error(world().replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 570, y: -10, tolerance: 1}"))
+    (`TIMEOUT (robot timeout, b success) after 60.00 s`). The rule said: the two bodies'
+    half-widths, plus the first's tolerance less the second's."""
+    text = error(goals("{x: 570, y: -10}", "{x: 570, y: -10, tolerance: 1}"))
     assert ("w.yaml:13:13: world error: the goals (q_goal) of `robot` at (570, -10) and `b` at "
-            "(570, -10) are too close for both robots to stand at them: 0.0 in apart, with "
-            "tolerances of 12 and 1 in, the two centres are at most 13.0 in apart there, and the "
-            "bodies need 18 in (half of each one's narrower side): whichever arrives first "
-            "parks in the other's way\n") in text
-    assert "hint: move the goals 5 in or more farther apart, or widen a tolerance" in text
-    # 5 in apart, the centres may stand 18 in apart: taken; so are two goals of 12 in each
-    assert parse_world(world().replace("q_goal: {x: 30, y: 10}",
-                                       "q_goal: {x: 575, y: -10, tolerance: 1}"), "w.yaml")
-    assert parse_world(world().replace("q_goal: {x: 30, y: 10}", "q_goal: {x: 570, y: -10}"),
-                       "w.yaml")
+            "(570, -10) are 0.0 in apart; two robots' goals must be at least 29 in apart: half "
+            "of each one's narrower side (9 + 9 in) plus the first's tolerance less the "
+            "second's (12 - 1 in). `robot`, arriving first, may park anywhere within 12 in of "
+            "its goal, and `b` then has no room to stand within 1 in of its own\n"
+            "        q_goal: {x: 570, y: -10, tolerance: 1}\n"
+            "                ^\n") in text
+    assert "hint: move the goals 29 in or more farther apart, or widen `b`'s tolerance to 18 in" \
+        in text
+    text = error(goals("{x: 300, y: -10}", "{x: 300, y: 18, tolerance: 1}"))
+    assert "are 28.0 in apart; two robots' goals must be at least 29 in apart" in text
+    assert "move the goals 1 in or more farther apart" in text
+    assert parse_world(goals("{x: 300, y: -10}", "{x: 300, y: 19, tolerance: 1}"), "w.yaml")
+    # tolerances as wide as the two half-widths: room wherever the other parks
+    assert "widen `robot`'s tolerance to 18 in" in error(
+        goals("{x: 300, y: -10}", "{x: 300, y: -10, tolerance: 18}"))
+    assert parse_world(goals("{x: 300, y: -10, tolerance: 18}",
+                             "{x: 300, y: -10, tolerance: 18}"), "w.yaml")
+
+
+def test_two_robots_given_one_goal_are_refused():
+    """Both robots' goals at one point with tolerances of 12 in were taken (the two centres
+    could stand 24 in apart there, the bodies needing 18): the robot that came second drove
+    at the first, parked where it entered its tolerance (`fleet_tiny` with one goal and a
+    time limit of 90 s: 1 success in 20 runs, 11 collisions, 8 stuck)."""
+    text = error(goals("{x: 300, y: -10}", "{x: 300, y: -10}"))
+    assert ("w.yaml:13:13: world error: the goals (q_goal) of `robot` at (300, -10) and `b` at "
+            "(300, -10) are 0.0 in apart; two robots' goals must be at least 18 in apart: half "
+            "of each one's narrower side (9 + 9 in) plus the first's tolerance less the "
+            "second's (12 - 12 in)") in text
+    assert "hint: move the goals 18 in or more farther apart, or widen `b`'s tolerance to 18 in" \
+        in text
+    assert "move the goals 1 in or more" in error(goals("{x: 300, y: -10}", "{x: 300, y: 7}"))
+    assert parse_world(goals("{x: 300, y: -10}", "{x: 300, y: 8}"), "w.yaml")
 
 
 def test_a_goal_inside_a_robot_parked_from_its_start_is_refused():

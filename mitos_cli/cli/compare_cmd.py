@@ -332,7 +332,7 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
     """Run the study with a progress bar on stderr (on a terminal, without ``--json``; piped,
     a line every few percent). On Ctrl-C: say how many runs are kept in ``out`` and how to go
     on (the study's command, then ``how``: the options it was run with), and exit 130; on a
-    SIGTERM the same, exiting 143."""
+    SIGTERM the same, exiting 143, and on a SIGHUP (the terminal closed), exiting 129."""
     from ..study import run_study
 
     kept = {"before": 0, "now": 0, "total": 0}
@@ -353,7 +353,7 @@ def run_with_progress(study: Study, out: str, executor: str, workers: int | None
                                  scheduler=scheduler, resume=resume, on_start=on_start,
                                  on_result=on_result,
                                  on_clock=lambda t: bar.status(f"at {t:.0f} s"))
-        except KeyboardInterrupt as exc:        # (a SIGTERM too: Terminated)
+        except KeyboardInterrupt as exc:        # (a SIGTERM, a SIGHUP too: Terminated)
             stopped = stopped_code(exc)
     if not kept["total"] and not resume:      # before on_start: no run of it is kept
         err(f"interrupted before the study began in {out}; start it with:\n  {study.command}{how}")

@@ -19,6 +19,9 @@ INTERRUPTED = 130
 #: The exit code of a command stopped by SIGTERM (128 + SIGTERM), as shells report it.
 TERMINATED = 143
 
+#: The exit code of a command stopped by SIGHUP (128 + SIGHUP): its terminal closed.
+HUNG_UP = 129
+
 
 #: Off a terminal, a progress line each time this many more percent are done.
 LINE_EVERY_PERCENT = 5
@@ -88,34 +91,71 @@ def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> 
 
 
 class Terminated(KeyboardInterrupt):
-    """A SIGTERM (``kill PID``, a batch scheduler's time limit) raised where the command is, as
-    Ctrl-C raises KeyboardInterrupt: what stops cleanly on one stops so on the other."""
+    """A SIGTERM (``kill PID``, a batch scheduler's time limit) or a SIGHUP (the terminal
+    closed, an ssh session dropped) raised where the command is, as Ctrl-C raises
+    KeyboardInterrupt: what stops cleanly on one stops so on the others. ``code`` is the
+    exit code a shell expects of the signal (143, 129)."""
+
+    def __init__(self, code: int = TERMINATED) -> None:
+        super().__init__()
+        self.code = code
 
 
-def stopped_code(exc: KeyboardInterrupt) -> int:
-    """The exit code of a command stopped by ``exc``: 143 for a SIGTERM, else 130."""
-    return TERMINATED if isinstance(exc, Terminated) else INTERRUPTED
+def stopped_code(exc: BaseException) -> int:
+    """The exit code of a command stopped by ``exc``: 143 for a SIGTERM, 129 for a SIGHUP,
+    else 130."""
+    return exc.code if isinstance(exc, Terminated) else INTERRUPTED
+
+
+#: The signals that stop a command as Ctrl-C does (SIGHUP: not on Windows).
+STOPPING = ("SIGTERM", "SIGHUP")
 
 
 @contextmanager
 def terminate_as_interrupt() -> Iterator[None]:
-    """While the block runs, a SIGTERM raises :class:`Terminated` (``mitos compare``: its
-    runs kept, the workers ended, the command that goes on said, where the signal ended the
-    process at once and left that to be guessed). Not from a thread other than the main
-    one (only it may set a handler), nor where SIGTERM is ignored (a caller's choice)."""
+    """While the block runs, a SIGTERM or a SIGHUP raises :class:`Terminated` (``mitos
+    compare`` and ``simulate``: the runs done kept, the workers ended, what was kept said,
+    where the signal ended the process at once and left that to be guessed). Not from a
+    thread other than the main one (only it may set a handler), nor for a signal ignored
+    (a caller's choice: ``nohup`` ignores SIGHUP so that the command goes on)."""
     import signal
     import threading
 
-    if threading.current_thread() is not threading.main_thread() or \
-            signal.getsignal(signal.SIGTERM) is signal.SIG_IGN:
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def terminated(signum: int, frame: object) -> None:
-        raise Terminated
+        if signum != signal.SIGTERM:
+            drop_lost_terminal()
+        raise Terminated(128 + signum)
 
-    previous = signal.signal(signal.SIGTERM, terminated)
+    previous = {}
+    for name in STOPPING:
+        number = getattr(signal, name, None)
+        if number is not None and signal.getsignal(number) is not signal.SIG_IGN:
+            previous[number] = signal.signal(number, terminated)
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def drop_lost_terminal() -> None:
+    """Point stdout and stderr at the null device where they are a terminal that has hung up
+    (closed: every write to it fails, EIO). The words of a stop on SIGHUP, and the progress
+    bar's last frame, ended in "cannot write the output: Input/output error" and exit 1 (a
+    traceback where stderr was that terminal too). A file or a pipe is kept (``2> log``:
+    the log says what was kept), and so is a terminal still there (``kill -HUP``)."""
+    import errno
+    import os
+
+    for fd in (1, 2):
+        try:
+            os.write(fd, b"")           # (nothing; on a terminal hung up, EIO)
+        except OSError as exc:
+            if exc.errno == errno.EIO:
+                null = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(null, fd)
+                os.close(null)

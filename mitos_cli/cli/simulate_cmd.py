@@ -12,7 +12,7 @@ from ..words import clearance, percent, plural
 from . import complete
 from .output import emit, err, json_text, warn
 from .params import MAX_RUNS, WORDS, Factor, Number, file_arg, named, option_names
-from .progress import INTERRUPTED, progress_bar
+from .progress import Terminated, progress_bar, stopped_code, terminate_as_interrupt
 from .targets import check_directory, check_suffix
 
 if TYPE_CHECKING:
@@ -177,9 +177,10 @@ def _draw_runs(result: Runs, world: World, plot: Path) -> Runs:
 
 
 def _run_many(loaded: list[World], runs: int, seed: int | None, planner: Planner, workers: int | None,
-             plot: Path | None, quiet: bool) -> tuple[Runs, int | None]:
-    """``run_many`` with a progress bar on a terminal. Returns the runs and, when Ctrl-C
-    stopped them, how many were asked for (``None`` otherwise): the finished ones are kept."""
+             plot: Path | None, quiet: bool) -> tuple[Runs, int | None, int]:
+    """``run_many`` with a progress bar on a terminal. Returns the runs and, when Ctrl-C (or
+    a SIGTERM, a SIGHUP) stopped them, how many were asked for (``None`` otherwise) and the
+    exit code to stop with: the finished ones are kept."""
     from ..sim.runs import RunsInterrupted, run_many, trail
 
     label = f"{len(loaded)} worlds" if len(loaded) > 1 else loaded[0].name
@@ -187,9 +188,9 @@ def _run_many(loaded: list[World], runs: int, seed: int | None, planner: Planner
         try:
             return run_many(loaded, runs, seed, planner, workers,
                             measure=trail if plot is not None else None, on_progress=bar.update,
-                            on_clock=lambda t: bar.status(f"runs at {t:.0f} s")), None
+                            on_clock=lambda t: bar.status(f"runs at {t:.0f} s")), None, 0
         except RunsInterrupted as stop:
-            return stop.runs, stop.total
+            return stop.runs, stop.total, stopped_code(stop.interrupt)
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -304,11 +305,18 @@ def simulate_command(
     _check_run_options(many, len(loaded), runs, randomise, out, trace, live, animate, plot)
     _check_partners(many, trace, every, animate, fps, workers)
     planner = make_planner(planner_name, loaded[0], rulebase, behavior)
-    if many:
-        _simulate_many(loaded, runs, seed, planner, workers, plot, as_json, require)
-    else:
-        _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace, every or 20,
-                      as_json, out, plot, animate, fps or 10.0, require)
+    # a SIGTERM (`kill PID`, a scheduler's time limit) or a SIGHUP (the terminal closed)
+    # stops as Ctrl-C does, saying what was kept (they ended the process without a word,
+    # the finished runs lost); exit 143, 129
+    with terminate_as_interrupt():
+        try:
+            if many:
+                _simulate_many(loaded, runs, seed, planner, workers, plot, as_json, require)
+            else:
+                _simulate_one(loaded[0], planner, seed, randomise, live, speed, trace,
+                              every or 20, as_json, out, plot, animate, fps or 10.0, require)
+        except Terminated as exc:      # where Ctrl-C ends quietly too (the output printed)
+            raise typer.Exit(exc.code) from None
 
 
 def _load_worlds(names: list[str]) -> list:
@@ -402,11 +410,11 @@ def _simulate_many(loaded: list[World], runs: int, seed: int | None, planner: Pl
                    require: str | None) -> None:
     """Several worlds or ``--runs``: the outcome table (or JSON) and the runs' picture; after
     Ctrl-C, what finished."""
-    result, stopped = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
+    result, stopped, code = _run_many(loaded, runs, seed, planner, workers, plot, as_json)
     if stopped is not None:
         if not result.worlds:
             err(f"interrupted before any run finished (0 of {stopped}); nothing written")
-            raise typer.Exit(INTERRUPTED)
+            raise typer.Exit(code)
         plot = plot if len(result.worlds) == len(loaded) else None
     if plot is not None:
         result = _draw_runs(result, loaded[0], plot)
@@ -418,7 +426,7 @@ def _simulate_many(loaded: list[World], runs: int, seed: int | None, planner: Pl
         what = "the JSON has" if as_json else "the table has"
         err(f"interrupted: {what} the {done} of {stopped} runs that had finished "
             f"(their seeds: runs_detail in --json)")
-        raise typer.Exit(INTERRUPTED)
+        raise typer.Exit(code)
     failed = any(s["outcome"] != "success" for w in result.worlds for s in w.summaries)
     if require and failed:
         raise typer.Exit(3)
@@ -442,9 +450,9 @@ def _simulate_one(world: World, planner: Planner, seed: int | None, randomise: b
     written: list[str] = []
     try:
         frames = _write_outputs(res, planner, out, plot, animate, fps, written)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         err(_interrupted_writing(written))
-        raise typer.Exit(INTERRUPTED) from None
+        raise typer.Exit(stopped_code(exc)) from None
     if as_json:
         emit(json_text(res.summary()))
     else:
@@ -504,7 +512,7 @@ def _run_one(world: World, planner: Planner, seed: int | None, randomise: bool, 
                       speed=1.0 if speed is None else speed) as view:
             return simulate(world, planner, seed, randomise=randomise, scene=scene,
                             on_tick=view.update)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         err("interrupted: nothing written (the view shows the last tick drawn)" if live
             else "interrupted before the run ended: nothing written")
-        raise typer.Exit(INTERRUPTED) from None
+        raise typer.Exit(stopped_code(exc)) from None

@@ -62,13 +62,18 @@ def _chunk_runs(task: tuple) -> Iterator[Part]:
 def ignore_interrupts() -> None:
     """A pool worker's initializer: Ctrl-C reaches the whole process group, and only the
     parent should answer it (the workers are terminated; no ``Process ForkPoolWorker-1:``).
-    A SIGTERM ends the worker as the signal does, whatever the parent answers it with
-    (``mitos compare`` stops as on Ctrl-C: a worker forked with that handler raised where
-    ``Pool.terminate`` ends it)."""
+    A SIGTERM or a SIGHUP ends the worker as the signal does, whatever the parent answers
+    it with (``mitos compare`` and ``simulate`` stop as on Ctrl-C: a worker forked with that
+    handler raised where ``Pool.terminate`` ends it, and a closed terminal's SIGHUP reaches
+    the whole process group; ignored, as ``nohup`` does, it stays so). ``Pool.terminate``
+    ends its workers with a SIGTERM: it is never ignored."""
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    hangup = getattr(signal, "SIGHUP", None)         # (not on Windows)
+    if hangup is not None and signal.getsignal(hangup) is not signal.SIG_IGN:
+        signal.signal(hangup, signal.SIG_DFL)
 
 
 def end_with_parent() -> None:
@@ -226,11 +231,15 @@ def default_workers(worlds: Sequence[World] = ()) -> int:
 
 class RunsInterrupted(KeyboardInterrupt):
     """Ctrl-C during :func:`run_many`: ``runs`` holds the runs that had finished (each world's
-    in seed order; a world with none is left out), ``total`` how many were asked for."""
+    in seed order; a world with none is left out), ``total`` how many were asked for, and
+    ``interrupt`` the KeyboardInterrupt that stopped them (a caller's own kind, such as the
+    command line's for a SIGTERM, whose exit code differs from Ctrl-C's)."""
 
-    def __init__(self, runs: Runs, total: int) -> None:
+    def __init__(self, runs: Runs, total: int,
+                 interrupt: KeyboardInterrupt | None = None) -> None:
         super().__init__()
         self.runs, self.total = runs, total
+        self.interrupt = interrupt if interrupt is not None else KeyboardInterrupt()
 
     @property
     def finished(self) -> int:
@@ -293,8 +302,8 @@ def run_many(worlds: list[World], runs: int = 0, seed: int | None = None, planne
                 clocks.pop(k, None)
             if on_progress is not None:
                 on_progress(done, total)
-    except KeyboardInterrupt:
-        raise RunsInterrupted(_group(worlds, tasks, results), total) from None
+    except KeyboardInterrupt as stop:
+        raise RunsInterrupted(_group(worlds, tasks, results), total, stop) from None
     return _group(worlds, tasks, results)
 
 

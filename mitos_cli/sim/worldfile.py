@@ -1363,10 +1363,11 @@ GOAL_CIRCLE = 360
 
 
 def _goal_taken(p: Agent, q: Agent) -> tuple[str, str] | None:
-    """Why ``q`` can never stand at its goal while ``p`` stands at its own, or None. A robot
-    stands at its goal with its centre anywhere within the tolerance, turned any way, so
-    only what every such pose must touch is refused: the disc of half its narrower side
-    about its centre (half its width, as :func:`_check_goal_room` keeps from walls)."""
+    """Why ``q`` may find no place at its goal once ``p`` stands at its own, or None. A robot
+    stands at its goal with its centre anywhere within the tolerance, turned any way: ``p``
+    where it entered its tolerance, and ``q`` wherever it finds room. A body is taken as
+    the disc of half its narrower side about its centre (half its width, as
+    :func:`_check_goal_room` keeps from walls), what every pose of it covers."""
     import numpy as np
 
     r = min(q.robot.length, q.robot.width) / 2
@@ -1393,19 +1394,27 @@ def _goal_taken(p: Agent, q: Agent) -> tuple[str, str] | None:
                 f"centre comes at most {far:.1f} in from `{p.name}`'s body, and its own body "
                 f"needs {r:g} in",
                 f"move the goal, or start `{p.name}` farther from its own goal")
+    # `p`, arrived first, parks where it enters its tolerance, which may be as close to
+    # q's goal as `apart - tp` (on it, where that is negative); q's centre, within t of its
+    # goal, then gets at most t farther from p's. Not where the two could stand at best
+    # (`apart + tp + t`): two goals at one point with tolerances of 12 in were taken so, and
+    # the robot that came second drove at the first, parked, till a collision or the time
+    # limit (`fleet_tiny` so, with a time limit of 90 s: 1 success in 20 runs).
     rp = min(p.robot.length, p.robot.width) / 2
     pg, tp = p.goal, p.goal.tolerance
     apart = math.hypot(g.x - pg.x, g.y - pg.y)
-    if apart + t + tp >= r + rp:
+    need = r + rp
+    if t >= need or apart - tp + t >= need:
         return None
+    least = need + tp - t
     return (f"the goals (q_goal) of `{p.name}` at ({pg.x:g}, {pg.y:g}) and `{q.name}` at "
-            f"({g.x:g}, {g.y:g}) are too close for both robots to stand at them: "
-            f"{apart:.1f} in apart, with tolerances of {tp:g} and {t:g} in, the two centres "
-            f"are at most {apart + tp + t:.1f} in apart there, and the bodies need {r + rp:g} "
-            f"in (half of each one's narrower side): whichever arrives first parks in the "
-            f"other's way",
-            f"move the goals {math.ceil(r + rp - tp - t - apart - 1e-9)} in or more farther "
-            f"apart, or widen a tolerance")
+            f"({g.x:g}, {g.y:g}) are {apart:.1f} in apart; two robots' goals must be at "
+            f"least {least:g} in apart: half of each one's narrower side ({rp:g} + {r:g} in) "
+            f"plus the first's tolerance less the second's ({tp:g} - {t:g} in). `{p.name}`, "
+            f"arriving first, may park anywhere within {tp:g} in of its goal, and `{q.name}` "
+            f"then has no room to stand within {t:g} in of its own",
+            f"move the goals {math.ceil(least - apart - 1e-9)} in or more farther apart, "
+            f"or widen `{q.name}`'s tolerance to {need:g} in")
 
 
 def check_jitters(world: World, written: YMap) -> None:

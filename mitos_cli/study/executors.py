@@ -235,7 +235,7 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
     The workers of a remote cluster must have ``mitos`` installed and see the world files at
     the paths given on the command line (a shared file system).
     """
-    own = client is None
+    own, stopped = client is None, False
     if client is None:             # a LocalCluster of no more processes than tasks (-j 500)
         client = dask_client(scheduler, min(workers, max(1, len(tasks))))
     try:
@@ -250,10 +250,10 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
             for _future, part in as_completed(futures, with_results=True):
                 yield from part
         except BaseException:
+            stopped = True
             if own and getattr(client, "cluster", None) is not None:
                 client.run(quiet_logs)      # its closing now cancels runs, which they log,
-                client.run(quiet_logs, nanny=True)       # as do the workers' nannies
-                quiet_logs()                # and this process's client ("Couldn't gather")
+                quiet_logs()                # as do the nannies and the client, in this process
             raise
         finally:
             client.cancel(futures)
@@ -262,7 +262,31 @@ def run_dask(fn: TaskFn, tasks: Sequence[Task], workers: int, scheduler: str | N
             cluster = getattr(client, "cluster", None)
             client.close()
             if cluster is not None:
+                if stopped:
+                    stop_workers(cluster)
                 cluster.close()
+
+
+#: Seconds a LocalCluster's worker stopped early is given to end the chunk it is in before it
+#: is killed (Dask's nanny gives it 4: a Ctrl-C took 1 to 4 s to end the command).
+STOP_WAIT = 0.25
+
+
+def stop_workers(cluster: LocalCluster, wait: float = STOP_WAIT) -> None:
+    """Close the worker processes of ``cluster`` (a study stopped early: Ctrl-C, an error),
+    each given ``wait`` seconds to end, then killed. Closing a cluster waits, worker by
+    worker, for the task each is in (a chunk of runs, whose results nobody will read now)
+    for up to 4 s (``Nanny.close``'s default timeout of 5 s, 0.8 of it for the task) before
+    it kills it; ``Nanny.close(timeout=...)`` is the same closing, with a shorter wait, all
+    at once."""
+    import asyncio
+
+    async def close_all() -> None:
+        await asyncio.gather(*(worker.close(timeout=wait / 0.8)
+                               for worker in list(cluster.workers.values())),
+                             return_exceptions=True)
+
+    cluster.sync(close_all)
 
 
 def execute(fn: TaskFn, tasks: Sequence[Task], executor: str = "local",
