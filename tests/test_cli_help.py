@@ -157,6 +157,17 @@ def test_every_choice_an_option_lists_is_said_in_its_help():
     assert unsaid == []
 
 
+def test_an_option_mitos_list_names_says_it_takes_a_packaged_name():
+    """`mitos list` heads its rule bases `(--rulebase NAME)` and its lessons `(mitos teach
+    --lesson NAME)`, and both options take such a name, but their help said only `PATH`,
+    "Rule base", and "a lesson file"."""
+    every = commands()
+    for name, option in (("simulate", "--rulebase"), ("compare", "--rulebase"),
+                         ("teach", "--lesson")):
+        param = next(p for p in every[name].params if option in p.opts)
+        assert "NAME" in param.metavar and "mitos list" in param.help, (name, option)
+
+
 def test_a_rule_base_argument_is_called_the_same_in_every_command():
     """`teach` called its rule file `[RULES]` where eval, check and plot say `[RULEBASE]`."""
     for name, cmd in commands().items():
