@@ -247,8 +247,8 @@ def _print_tables(outcome: Outcome) -> None:
     console.print(table)
     console.print(ranking)
     note = overlap_note(outcome.ranks)
-    if note:
-        console.print(note, markup=False)
+    if note:                               # in a file, one line: never a label cut in two
+        console.print(note, markup=False, soft_wrap=not console.is_terminal)
 
 
 def outcome_json(outcome: Outcome, out: str) -> dict:
