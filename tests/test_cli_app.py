@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -54,6 +55,24 @@ def test_version_is_the_package_version() -> None:
     from mitos_cli.errors import DISTRIBUTION
 
     assert version(DISTRIBUTION) == __version__         # what pip installed says the same
+
+
+def test_version_has_a_help_and_takes_no_argument() -> None:
+    """`mitos version --help` and `mitos help version` said "No such command 'version'"
+    (exit 2) while `mitos version` printed the version; `mitos help help` said the same of
+    `help`."""
+    helped = run("version", "--help")
+    assert helped.returncode == 0 and helped.stderr == ""
+    assert "Usage: mitos version" in helped.stdout and "mitos --version" in helped.stdout
+    assert run("help", "version").stdout == helped.stdout
+    extra = run("version", "now")
+    assert extra.returncode == 2 and "unexpected extra argument" in extra.stderr and "(now)" in extra.stderr
+    assert "No such command" not in extra.stderr
+    threads = subprocess.run([sys.executable, "-m", "mitos_cli", "version"], text=True,
+                             capture_output=True, env={**os.environ, "MITOS_NUM_THREADS": "x"})
+    assert threads.returncode == 0 and threads.stdout.startswith("mitos ")   # as --version
+    twice = run("help", "help")
+    assert twice.returncode == 0 and twice.stdout == run("--help").stdout
 
 
 def test_a_value_outside_an_options_names_is_a_mistake_in_a_value(capsys) -> None:

@@ -39,6 +39,26 @@ def test_every_command_has_examples_and_exit_codes():
         assert [c for c, _ in exit_codes(name)][:3] == [0, 1, 2]
 
 
+def test_a_group_s_help_ends_with_its_commands_examples_and_exit_codes():
+    """`mitos plot --help` listed its three commands and ended there, where the README says
+    every `mitos COMMAND --help` ends with examples and the exit codes."""
+    from mitos_cli.cli.help import epilog
+
+    group = typer.main.get_group(build_app())
+    groups = {name: cmd for name, cmd in group.commands.items() if hasattr(cmd, "commands")}
+    assert sorted(groups) == ["plot"]
+    for name, cmd in groups.items():
+        assert cmd.epilog == epilog(name)
+        for sub in cmd.commands:                    # the first example of each subcommand
+            assert f"  {EXAMPLES[f'{name} {sub}'][0][0]}" in cmd.epilog.splitlines()
+        assert max(len(line) for line in cmd.epilog.splitlines()) <= 76
+    env = {**os.environ, "COLUMNS": "100", "PYTHONPATH": str(ROOT)}
+    out = subprocess.run([sys.executable, "-m", "mitos_cli", "plot", "--help"],
+                         capture_output=True, text=True, env=env, cwd=ROOT).stdout
+    assert "mitos plot surface steering --x road --y position --fix size=45 -o s.png" in out
+    assert "2    a usage error" in out
+
+
 @pytest.mark.parametrize("name", sorted(EXAMPLES))
 def test_examples_parse_and_name_files_that_exist(name):
     cmd = commands()[name]
@@ -135,6 +155,17 @@ def test_every_choice_an_option_lists_is_said_in_its_help():
                 if not re.search(rf"\b{value}\b", param.help or ""):
                     unsaid.append(f"{name} {param.opts[0]} {value}")
     assert unsaid == []
+
+
+def test_an_option_mitos_list_names_says_it_takes_a_packaged_name():
+    """`mitos list` heads its rule bases `(--rulebase NAME)` and its lessons `(mitos teach
+    --lesson NAME)`, and both options take such a name, but their help said only `PATH`,
+    "Rule base", and "a lesson file"."""
+    every = commands()
+    for name, option in (("simulate", "--rulebase"), ("compare", "--rulebase"),
+                         ("teach", "--lesson")):
+        param = next(p for p in every[name].params if option in p.opts)
+        assert "NAME" in param.metavar and "mitos list" in param.help, (name, option)
 
 
 def test_a_rule_base_argument_is_called_the_same_in_every_command():

@@ -82,6 +82,24 @@ def test_compare_writes_table_csv_and_report(tiny, tmp_path, compare):
     assert all(len(s) == 1 for s in seeds.values())
 
 
+def test_the_note_under_the_ranking_is_one_line_in_a_file(tiny, tmp_path, compare):
+    """Piped or into a file the table is as wide as it needs, but the note under the ranking
+    was wrapped at that width, splitting a choice's label over two lines (`fuzzy` /
+    `and=lukasiewicz`) for whoever reads it with grep."""
+    norms = "min,product,lukasiewicz,einstein,hamacher,nilpotent_minimum"
+    r = compare(tiny, "--and", norms, "--planner", "fuzzy", "--runs", 1, "-o",
+                tmp_path / "s", "-j", 1, "--no-plots")
+    assert r.exit_code == 0, r.output
+    lines = r.stdout.splitlines()
+    note = next(i for i, line in enumerate(lines) if "not distinguishable" in line)
+    assert lines[note].startswith("5 of 5 choices are not distinguishable from the leader")
+    assert len(lines[note]) > max(len(line) for line in lines[:note])    # wider than the tables
+    leader = lines[note].split("leader (")[1].split(")")[0]
+    assert sorted(lines[note].split("): ")[1].split(", ")) == \
+        sorted(f"fuzzy and={n}" for n in norms.split(",") if f"fuzzy and={n}" != leader)
+    assert lines[note + 1:] == []
+
+
 def test_each_row_has_the_replans_and_backouts_of_its_run(tiny, tmp_path, compare):
     """results.csv had no replans or backouts: a row carries its run's, the very figures
     `mitos simulate WORLD --seed SEED --randomise` prints for it."""

@@ -49,6 +49,15 @@ def test_a_wrapped_rule_is_one_line_of_the_history_and_of_undo(rules):
         "   2  if road is NARROW and size is SMALL_SZ then speed is SLOW  (undone)", "   3  undo"]
 
 
+def test_the_history_names_the_packaged_rule_base_as_every_command_does():
+    """`show history` of a session on the packaged rule base began `started on
+    /.../site-packages/mitos_cli/_data/rulebases/mitos.rules`, where pip put it; every other
+    answer calls it `rulebases/mitos.rules (packaged)`."""
+    s, out = session(default_rulebase_path())
+    assert say(s, out, "show history").splitlines()[0] == \
+        "   1  started on rulebases/mitos.rules (packaged), behavior avoid_obstacle"
+
+
 def test_advice_to_use_a_behavior_while_one_is_open_closes_it_first(rules):
     """While a behavior is open, `use NAME` is one of its lines (a blend), not a recall: the
     notes that said "`use b1` before `adapt`" led to "`b1` uses `b1`: a cycle" (b1 open again

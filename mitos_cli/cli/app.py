@@ -55,6 +55,13 @@ def _root(version: Annotated[bool, typer.Option(
     bases. Rule files, term sets, worlds and lessons are documented in the README."""
 
 
+def _version() -> None:
+    """Print the version of MITOS, as `mitos --version` does."""
+    from .._version import __version__
+
+    print(f"mitos {__version__}")
+
+
 def build_app(only: str | None = None) -> typer.Typer:
     """The ``mitos`` app with every command, or with just the command ``only``."""
     app = typer.Typer(
@@ -68,6 +75,10 @@ def build_app(only: str | None = None) -> typer.Typer:
         cls=MeantGroup,
     )
     app.callback()(_root)
+    if only == "version":           # `mitos version`, as `git version`: built for it alone,
+        app.command("version", cls=OnceCommand,  # so that `mitos --help` lists --version once
+                    help=paragraphs(_version.__doc__))(_version)
+        return app
     for name, (module, attr) in COMMANDS.items():
         if only is not None and name != only:
             continue
@@ -108,11 +119,13 @@ def _main(argv: list[str] | None) -> None:
     sane_widths()
     args = sys.argv[1:] if argv is None else list(argv)
     if args[:1] == ["help"]:        # `mitos help`, `mitos help plot terms`: as git's and pip's
-        args = [*args[1:], "--help"]    # (it said "No such command 'help'", exit 2)
-    if args == ["version"]:         # `mitos version`, as `git version` (it was "No such command")
-        args = ["--version"]
+        words = args[1:]                # (it said "No such command 'help'", exit 2)
+        while words[:1] == ["help"]:    # `mitos help help`: the help of mitos
+            words = words[1:]
+        args = [*words, "--help"]
     first = args[0] if args else None
-    app = build_app(first if first in COMMANDS else None)
+    # `mitos version` (as `git version`; it was "No such command"), with its --help
+    app = build_app(first if first in COMMANDS or first == "version" else None)
     try:
         from ..engine.threads import given
 
@@ -160,7 +173,8 @@ def _asks_about(args: list[str]) -> bool:
     import os
 
     options = args[:args.index("--")] if "--" in args else args
-    return not args or "_MITOS_COMPLETE" in os.environ or any(a in ABOUT for a in options)
+    return (not args or args[:1] == ["version"] or "_MITOS_COMPLETE" in os.environ
+            or any(a in ABOUT for a in options))
 
 
 def path_error(exc: OSError) -> MitosError:

@@ -73,8 +73,9 @@ def compare_command(
         "--resume", help="Continue the study in DIR: skip every run already in results.csv "
                          "(DIR must hold one; without --resume a study starts there).")] = False,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", "-r", metavar="PATH", callback=named,
-        help="Rule base of the fuzzy planner (default: the packaged one).")] = None,
+        "--rulebase", "-r", metavar="PATH|NAME", callback=named,
+        help="Rule base of the fuzzy planner: a file, or a packaged one by name (`mitos list "
+             "rulebases`; default: the packaged mitos.rules).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,
         help="Behavior to drive with (default: the world's).")] = None,
@@ -246,8 +247,8 @@ def _print_tables(outcome: Outcome) -> None:
     console.print(table)
     console.print(ranking)
     note = overlap_note(outcome.ranks)
-    if note:
-        console.print(note, markup=False)
+    if note:                               # in a file, one line: never a label cut in two
+        console.print(note, markup=False, soft_wrap=not console.is_terminal)
 
 
 def outcome_json(outcome: Outcome, out: str) -> dict:

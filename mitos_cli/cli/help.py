@@ -96,12 +96,20 @@ def exit_codes(command: str) -> tuple[tuple[int, str], ...]:
     return tuple(sorted(codes.items()))
 
 
+def examples(command: str) -> tuple[tuple[str, str], ...]:
+    """The examples of ``command``; of a group (``plot``), the first of each of its commands."""
+    if command in EXAMPLES:
+        return EXAMPLES[command]
+    return tuple(lines[0] for name, lines in EXAMPLES.items()
+                 if name.startswith(f"{command} "))
+
+
 def epilog(command: str) -> str:
     """The end of ``mitos COMMAND --help``: examples, then exit codes (rich markup escaped)."""
     from rich.markup import escape
 
     lines = ["Examples:"]
-    for line, what in EXAMPLES[command]:          # as a shell session: copy, paste, run
+    for line, what in examples(command):          # as a shell session: copy, paste, run
         lines += [f"  # {what}", f"  {line}"]
     lines += ["", "Exit codes:"]
     lines += [f"  {code:<3}  {meaning}" for code, meaning in exit_codes(command)]

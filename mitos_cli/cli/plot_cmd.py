@@ -47,6 +47,7 @@ plot_app = typer.Typer(
     name="plot",
     help="Draw a rule base: membership plots, control surfaces, the rule viewer "
          "(PNG/SVG with -o, a window with --show, else in the terminal).",
+    epilog=epilog("plot"),
     no_args_is_help=True,
     context_settings={"help_option_names": ["-h", "--help"]},
     cls=MeantGroup,

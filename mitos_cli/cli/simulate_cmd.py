@@ -205,8 +205,9 @@ def simulate_command(
         help="World files (default: the packaged corridor.yaml); names of packaged worlds "
              "such as figure4.yaml work from anywhere.")] = None,
     rulebase: Annotated[Optional[str], typer.Option(
-        "--rulebase", "-r", metavar="PATH", callback=named,
-        help="Rule base (default: the packaged one).")] = None,
+        "--rulebase", "-r", metavar="PATH|NAME", callback=named,
+        help="Rule base: a file, or a packaged one by name (`mitos list rulebases`; default: "
+             "the packaged mitos.rules).")] = None,
     behavior: Annotated[Optional[str], typer.Option(
         "--behavior", "-b", metavar="NAME", callback=named,
         help="Behavior that drives (default: the world's, else `drive`).")] = None,

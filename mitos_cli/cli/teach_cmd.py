@@ -55,9 +55,10 @@ def teach_command(
         help="The behavior to teach first (default: the file's first).")]
         = None,
     lesson: Annotated[str | None, typer.Option(
-        "--lesson", "-l", metavar="FILE|-", callback=named,
-        help="Run the commands of a lesson file (- for stdin) instead of the prompt; stop at "
-             "the first error (exit 1).")] = None,
+        "--lesson", "-l", metavar="FILE|NAME|-", callback=named,
+        help="Run the commands of a lesson file, a packaged lesson by name (`mitos list "
+             "lessons`) or stdin (-) instead of the prompt; stop at the first error "
+             "(exit 1).")] = None,
     save_as: Annotated[str | None, typer.Option(
         "--save-as", "-o", metavar="OUT.rules", callback=named,
         help="Where `save` writes: OUT.rules and its term set beside it, OUT.terms.yaml (a "

@@ -129,12 +129,22 @@ def one_line(command: str) -> str:
     return " ".join(part.strip() for part in command.splitlines() if part.strip())
 
 
+def _rule_file(path: str) -> str:
+    """The rule file a session started on: the packaged one as every command names it
+    (``rulebases/mitos.rules (packaged)``, not where pip put it), any other as recorded."""
+    from ..resources import packaged_name
+
+    packaged = packaged_name(path)
+    return path if packaged is None else f"{packaged} (packaged)"
+
+
 def history_text(entries: list[dict]) -> str:
     undone = {e["of"] for e in entries if e["op"] == "undo"}
     lines = []
     for e in entries:
         if e["op"] == "start":
-            lines.append(f"{e['seq']:>4}  started on {e['rules']} ({e['behavior']})")
+            lines.append(f"{e['seq']:>4}  started on {_rule_file(e['rules'])}, "
+                         f"behavior {e['behavior']}")
             continue
         text = one_line(e.get("line") or "") or e["op"]
         if e["op"] == "adapt":
