@@ -422,6 +422,19 @@ def test_head_on_in_a_corridor_with_room_for_two_is_no_crossing():
                             on_map(600, 15, 180, corridor_map())) is None
 
 
+def test_a_robot_standing_in_the_way_is_no_narrow_place_of_its_own():
+    """The other robot, standing mid-corridor and so marked on this one's map (a mate that
+    stands is), leaves 36 in on either side: room for this one to pass it, not a place for
+    the two to take in turn (``crossroads4_one_out`` seed 1014: the robot marked was told
+    to go, into the side of a robot that gives way to nobody)."""
+    seen = corridor_map((288.0, 312.0, -9.0, 9.0))          # its body as marked, at (300, 0)
+    standing = on_map(300, 0, 0, corridor_map(), speed=0.0)
+    coming = on_map(500, 15, 180, seen)
+    assert traffic.narrow(standing, coming) is None
+    elsewhere = on_map(500, 15, 180, corridor_map((288.0, 312.0, -9.0, 9.0)))
+    assert traffic.narrow(on_map(150, 0, 0, corridor_map(), speed=0.0), elsewhere) is not None
+
+
 def test_a_robot_giving_way_at_a_narrow_place_waits_in_its_lane_short_of_the_others_way():
     rmap = corridor_map(BOXES)
     bend = Route.of([(150, -15), (330, -15), (360, 25), (440, 25), (470, -15), (800, -15)])

@@ -192,7 +192,9 @@ def narrow(a: Mate, b: Mate) -> Crossing | None:
         return None
     need = a.lane + b.lane
     (wa, ma), (wb, mb) = across(a.map, pa, rows, need), across(b.map, pb, cols, need)
-    na, nb = wa < need, wb < need
+    # (not where the other itself, standing and marked, narrows the way beside it)
+    na = (wa < need) & (np.hypot(*(pa[rows] - b.at).T) > b.radius + a.lane)
+    nb = (wb < need) & (np.hypot(*(pb[cols] - a.at).T) > a.radius + b.lane)
     if not (na.any() or nb.any()):
         return None
     apart = d[np.ix_(rows, cols)] < zone(a, b)
