@@ -49,8 +49,9 @@ def test_the_architecture_page_names_every_module():
 
 def test_worlds_readme_annotated_world_runs_as_written(tmp_path):
     """worlds/README.md's "The format, annotated", saved as a file, was refused: its second
-    robot started at x = 770 in a corridor that ends at 600. It loads, and both robots arrive,
-    as the paragraph after it says."""
+    robot started at x = 770 in a corridor that ends at 600. It loads, and runs as the
+    paragraph after it says: `robot` waits for `oncoming` at the box, which leaves room for
+    one, and the cart runs into it."""
     import re
 
     from mitos_cli.sim import load_world, simulate
@@ -58,7 +59,9 @@ def test_worlds_readme_annotated_world_runs_as_written(tmp_path):
     text = (ROOT / "worlds" / "README.md").read_text(encoding="utf-8")
     world = tmp_path / "annotated.yaml"
     world.write_text(re.findall(r"```yaml\n(.*?)```", text, re.S)[0], encoding="utf-8")
-    assert simulate(load_world(world)).robot_outcomes == ("success", "success")
+    res = simulate(load_world(world))
+    assert res.robot_outcomes == ("collision", "stopped")
+    assert f"after {res.t[-1]:.2f} s" in text
 
 
 

@@ -404,9 +404,13 @@ def test_head_on_where_boxes_leave_room_for_one_the_robot_with_them_on_its_side_
     # boxes on the north side: the westbound waits
     north = corridor_map((360.0, 440.0, -5.0, 45.0))
     assert waits(on_map(200, -15, 0, north), on_map(600, 15, 180, north)) == [(1, 0)]
-    # (its route running on in its lane, it drives on: it waits where its route would take
-    # it into the other's way, below)
-    assert limits(east, west).tolist() == [math.inf, math.inf]
+    # its route running on in its lane (into the boxes, unseen), it stops short of the
+    # place: its front 12 in before where its route comes within the zone of the room west
+    # takes (x = 316), as never into the other's way (below)
+    room = traffic.room_before(east, east.point(c.enter[0]))
+    assert room == 316 - 200 - 12 - traffic.SLACK
+    lim = limits(east, west)
+    assert math.isinf(lim[1]) and lim[0] == math.sqrt((40 * DT) ** 2 + 2 * 40 * room) - 40 * DT
 
 
 def waits(*mates: traffic.Mate) -> list[tuple[int, int]]:
@@ -443,8 +447,13 @@ def test_a_robot_giving_way_at_a_narrow_place_waits_in_its_lane_short_of_the_oth
     # east's route comes within a lane (22 in) of west's, at y = 25, on its way up to the
     # room by the boxes, 152.5 in on (its places 4 in apart: the first within, 156 in): its
     # front stops SLACK short of there
-    room = traffic.room_beside(east, west)
-    assert room == 156 - 2 * 12 - traffic.SLACK
+    assert traffic.room_beside(east, west) == 156 - 2 * 12 - traffic.SLACK
+    # and never into the place: its route comes within the zone of west's narrow places
+    # 124 in on (x = 324), where the two met it; of the two rooms, the less
+    c = traffic.crossing(east, west)
+    assert c is not None and c.narrow and c.enter[0] == 124
+    room = traffic.room_before(east, east.point(c.enter[0]))
+    assert room == 124 - 12 - traffic.SLACK
     assert waits(east, west) == [(0, 1)]
     assert limits(east, west)[0] == math.sqrt((40 * DT) ** 2 + 2 * 40 * room) - 40 * DT
     west_gone = on_map(100, 25, 180, rmap)                 # west passed it: its way is clear

@@ -25,7 +25,7 @@ manager), and give way by the rule of the road:
   already inside stops where it is. It goes on once the other's route, rear included, has
   left the crossing. A robot waiting so is not ``stuck`` (:mod:`.loop`), and it leaves
   the echoes of the robot it waits on out of its tracks;
-- a **narrow place**: two robots coming towards each other where both routes pass a place
+- a **narrow place**: two robots head-on (at 135 deg or more) where both routes pass a place
   with room for one (:func:`narrow`: across either robot's route on its map, less than the
   two side by side with their margins; the place is often seen only once they have met)
   cross there in turn: the one with the obstruction on its side gives way (whoever comes
@@ -79,6 +79,10 @@ SLACK = 12.0
 #: slower, it stands in the way and is marked where it stands (a little under the slowest
 #: a tracker takes for moving, :data:`.movers.MIN_SPEED`, 6 in/s)
 MOVING = 5.0
+#: the least cosine of the angle between two routes' stretches near each other, negated,
+#: for robots coming towards each other at a narrow place (135 deg; at a crossing the rule
+#: of the road is the crossing's)
+HEAD_ON = math.sqrt(0.5)
 #: in: how far from its route a robot may drive: its keep-right lane (perception's ``road_cap``
 #: of 100 in, a quarter of it)
 LANE = 25.0
@@ -105,6 +109,11 @@ class Mate:
         """Whether the route ends at or before its path's place ``k`` (the robot stops there:
         its goal, or a refuge out of a cart's way, is no crossing)."""
         return self.progress - self.back + k * STEP >= self.route.length
+
+    def point(self, ahead: float) -> np.ndarray:
+        """``[2]`` the place of its route ``ahead`` in from its centre."""
+        s = min(max(self.progress + ahead, 0.0), self.route.length)
+        return self.route.points_at(np.array([s]))[0]
 
     @property
     def path(self) -> np.ndarray:
@@ -173,14 +182,16 @@ def crossing(a: Mate, b: Mate, known: bool = False, look_narrow: bool = True) ->
 
 
 def narrow(a: Mate, b: Mate) -> Crossing | None:
-    """Where ``a`` and ``b``, coming towards each other, both pass a place too narrow for the
-    two side by side (:func:`across` under the sum of their :attr:`Mate.lane`), as a
-    :class:`Crossing` from the first such place of each one's route to the last, or
-    ``None``; ``right`` if the room is on ``b``'s side. The routes are looked along until
-    each has passed the other robot (the place is seen late, and each sees only its own
-    side of it); a place is narrow on either robot's map, and a place of one route is in
-    the narrow where it lies within :func:`zone` of a narrow place of the other (the one
-    seen is often not on the other's route yet: it runs on where it has not seen it)."""
+    """Where ``a`` and ``b``, head-on (their routes' stretches near each other at
+    :data:`HEAD_ON` or more), both pass a place too narrow for the two side by side
+    (:func:`across` under the sum of their :attr:`Mate.lane`), as a :class:`Crossing` from
+    the first such place of each one's route to the last, or ``None``; ``right`` if the room
+    is on ``b``'s side. The routes are looked along until each has passed the other robot
+    (the place is seen late, and each sees only its own side of it); a place is narrow on
+    either robot's map, but not beside the other robot itself (standing, it is marked), and
+    a place of one route is in the narrow where it lies within :func:`zone` of a narrow
+    place of the other (the one seen is often not on the other's route yet: it runs on
+    where it has not seen it)."""
     if a.map is None or b.map is None:
         return None
     span = math.dist(a.at, b.at) + zone(a, b)
@@ -188,7 +199,8 @@ def narrow(a: Mate, b: Mate) -> Crossing | None:
     d = np.hypot(pa[:, None, 0] - pb[None, :, 0], pa[:, None, 1] - pb[None, :, 1])
     near = d < zone(a, b)
     rows, cols = near.any(axis=1).nonzero()[0], near.any(axis=0).nonzero()[0]
-    if not len(rows):
+    if not len(rows) or _cosine(_unit(pa[rows[-1]] - pa[rows[0]]),
+                                _unit(pb[cols[-1]] - pb[cols[0]])) > -HEAD_ON:
         return None
     need = a.lane + b.lane
     (wa, ma), (wb, mb) = across(a.map, pa, rows, need), across(b.map, pb, cols, need)
@@ -294,6 +306,13 @@ def first(a: Mate, b: Mate, c: Crossing, dt: float) -> bool:
     return not _time(b, c.leave[1]) + CLEAR_BY <= _time(a, c.enter[0])
 
 
+def room_before(a: Mate, entry: np.ndarray) -> float:
+    """How far (in) ``a``, giving way at a :func:`narrow` place, may drive at most: until its
+    front is :data:`SLACK` short of ``entry [2]``, where its route came to the place when the
+    two met it (measured straight)."""
+    return max(math.dist(a.at, entry) - a.back - SLACK, 0.0)
+
+
 def room_beside(a: Mate, b: Mate) -> float:
     """How far (in) ``a``, giving way to ``b`` at a :func:`narrow` place, may still drive:
     until its front is :data:`SLACK` short of where its route comes within a lane (half of
@@ -328,7 +347,8 @@ class Traffic:
     def __init__(self) -> None:
         self.order: dict[tuple[int, int], int] = {}     # (i, j), i < j -> the one first
         self.waits: list[tuple[int, int]] = []          # (robot, the robot it waits on)
-        self.narrows: set[tuple[int, int]] = set()      # (i, j) met at a narrow place
+        # (i, j) met head-on at a narrow place -> where each one's route comes to it
+        self.narrows: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
     def limits(self, mates: Sequence[Mate | None], dt: float) -> np.ndarray:
         """Each robot's speed limit (in/s; ``inf`` where it gives way to none) among
@@ -344,12 +364,12 @@ class Traffic:
                     crossing(a, b, (i, j) in self.order, (i, j) not in self.narrows)
                 if c is None or a is None or b is None:
                     self.order.pop((i, j), None)
-                    self.narrows.discard((i, j))
+                    self.narrows.pop((i, j), None)
                     continue
                 if (i, j) not in self.order or c.narrow:   # (a crossing found narrow: anew)
                     self.order[i, j] = i if first(a, b, c, dt) else j
                     if c.narrow:
-                        self.narrows.add((i, j))
+                        self.narrows[i, j] = (a.point(c.enter[0]), b.point(c.enter[1]))
                 if self.order[i, j] == i:
                     gives[j][i] = self._room(mates, j, i)
                 else:
@@ -365,10 +385,12 @@ class Traffic:
 
     def _room(self, mates: Sequence[Mate | None], i: int, j: int) -> float:
         """Robot ``i``'s room giving way to ``j``: short of the narrow place where the two
-        met head-on (:func:`room_beside`), else outside the crossing (:func:`room`)."""
+        met head-on (:func:`room_beside`, and never into the place: :func:`room_before`),
+        else outside the crossing (:func:`room`)."""
         a, b = cast(Mate, mates[i]), cast(Mate, mates[j])
-        if (min(i, j), max(i, j)) in self.narrows:
-            return room_beside(a, b)
+        entries = self.narrows.get((min(i, j), max(i, j)))
+        if entries is not None:
+            return min(room_beside(a, b), room_before(a, entries[0 if i < j else 1]))
         return room(a, b)
 
 
