@@ -30,8 +30,9 @@ manager), and give way by the rule of the road:
   two side by side with their margins; the place is often seen only once they have met)
   cross there in turn: the one with the obstruction on its side gives way (whoever comes
   to the place first), unless only it is committed. It waits in its lane, short of where
-  its route comes within a lane of the other's (:func:`room_beside`). Head-on where there
-  is room for two they pass each other as before;
+  its route comes within a lane of the other's (:func:`room_beside`) and never into the
+  place (:func:`room_before`). Head-on where there is room for two they pass each other as
+  before;
 - **mates are not walls**: a robot leaves off its map the echoes (:func:`echoes`) of the
   robots of its fleet that drive by, and of the one it waits on (:func:`unmarked`); its
   brake counts their bodies instead, each stretched by the room it takes to stop
