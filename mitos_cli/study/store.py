@@ -428,43 +428,7 @@ class ResultStore:
         Everything is checked before anything is written: a refused study leaves the directory
         as it was.
         """
-        try:                  # a directory this user cannot enter: a traceback here
-            there = self.dir.exists()
-            previous = self.manifest_path.exists() or self.path.exists()
-        except OSError as exc:
-            raise StudyError(f"cannot use the output directory {self.dir}: "
-                             f"{exc.strerror or exc}",
-                             hint="choose a directory you can write to with -o") from None
-        if there and not self.dir.is_dir():
-            raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
-                             hint="choose a directory with -o (a new one is made)")
-        if resume and not previous:
-            # a mistyped -o began a new study under the name, and "0 from before" was all
-            # that said the study meant was not resumed
-            raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
-                             f"results.csv)", hint="check the directory given with -o, or "
-                             "leave out --resume to start a study there")
-        parent = self.dir.parent
-        if not there and not parent.is_dir():
-            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
-            # `mkdir -p notes.txt` were no help
-            found = file_in_the_way(parent)
-            if found is not None:
-                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
-                                 f"is a file, not a directory",
-                                 hint="choose another directory with -o")
-            # the directory alone is made, as every other writer makes only its file: a
-            # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
-            raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
-                             f"does not exist",
-                             hint=f"create it first (`mkdir -p {shlex.quote(str(parent))}`), "
-                                  f"or choose "
-                                  f"another directory with -o (compare makes the last one)")
-        try:
-            self.dir.mkdir(exist_ok=True)
-        except OSError as exc:
-            raise StudyError(f"cannot create the output directory {self.dir}: "
-                             f"{exc.strerror or exc}") from None
+        self._open_dir(resume)
         self._hold()
         _refuse_special(self.manifest_path, "study manifest")   # (written to below)
         rows = loaded = self.load()
@@ -502,6 +466,48 @@ class ResultStore:
         # kept open across append() calls (one fsync'd line per finished run); close() closes it
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return finished, todo
+
+    def _open_dir(self, resume: bool) -> None:
+        """The study's directory made (only it: a mistyped parent is refused, not made) or
+        found, refused with what to do when it cannot hold the study: not there to resume,
+        a file, out of this user's reach, or under a file."""
+        try:                  # a directory this user cannot enter: a traceback here
+            there = self.dir.exists()
+            previous = self.manifest_path.exists() or self.path.exists()
+        except OSError as exc:
+            raise StudyError(f"cannot use the output directory {self.dir}: "
+                             f"{exc.strerror or exc}",
+                             hint="choose a directory you can write to with -o") from None
+        if there and not self.dir.is_dir():
+            raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
+                             hint="choose a directory with -o (a new one is made)")
+        if resume and not previous:
+            # a mistyped -o began a new study under the name, and "0 from before" was all
+            # that said the study meant was not resumed
+            raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
+                             f"results.csv)", hint="check the directory given with -o, or "
+                             "leave out --resume to start a study there")
+        parent = self.dir.parent
+        if not there and not parent.is_dir():
+            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
+            # `mkdir -p notes.txt` were no help
+            found = file_in_the_way(parent)
+            if found is not None:
+                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
+                                 f"is a file, not a directory",
+                                 hint="choose another directory with -o")
+            # the directory alone is made, as every other writer makes only its file: a
+            # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
+            raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
+                             f"does not exist",
+                             hint=f"create it first (`mkdir -p {shlex.quote(str(parent))}`), "
+                                  f"or choose "
+                                  f"another directory with -o (compare makes the last one)")
+        try:
+            self.dir.mkdir(exist_ok=True)
+        except OSError as exc:
+            raise StudyError(f"cannot create the output directory {self.dir}: "
+                             f"{exc.strerror or exc}") from None
 
     def _check_robots(self, rows: list[dict], robots: dict[str, tuple[str, ...]],
                       widen: bool) -> None:
