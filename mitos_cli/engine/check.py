@@ -782,20 +782,36 @@ def _sampled(compiled: CompiledRuleBase, threshold: float, resolution: int,
     info = GridInfo(compiled.behavior, tuple(zip(compiled.inputs, shape)), X.shape[0],
                     skipped, _size([corner_points(compiled, i) for i in every]),
                     exact is not None)
+    name = compiled.behavior
+    span = _behavior_span(compiled.rulebase, name)
+    out = _coverage(compiled, threshold, axes, X, dof, skipped, span, in_use, exact)
+
+    # rules that never fire: only the behavior's own (a used behavior's rules are judged in
+    # their own behavior, on its own, finer grid; here a `when` condition may silence them)
+    fires = (dof > 0.0).any(axis=0) if dof.shape[0] else np.zeros(compiled.n_rules, bool)
+    own = np.array([not contexts for _, _, contexts in flatten(compiled.rulebase, name)],
+                   dtype=bool)
+    out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
+    return out, info
+
+
+def _coverage(compiled: CompiledRuleBase, threshold: float, axes: list[np.ndarray],
+              X: np.ndarray, dof: np.ndarray, skipped: tuple[str, ...], span: Span | None,
+              in_use: InUse | None, exact: Exact | None) -> list[Finding]:
+    """The coverage findings of the grid ``X`` (``axes``; ``dof [n, R]`` its rules' DOFs),
+    per output: where no rule fires (unless ``exact`` decided that with no grid) and where
+    the total DOF is low. Outputs with the same gap are one finding
+    (:func:`_gap_groups`)."""
+    shape = tuple(len(a) for a in axes)
     thinned = (f" (on a grid that skipped corner points of {listed_names(skipped)}: there may "
                f"be more)" if skipped else "")
     out: list[Finding] = []
-    name = compiled.behavior
-    span = _behavior_span(compiled.rulebase, name)
-
-    # coverage, per output (grouping outputs that share the same gap)
     counting, missed = _counting(compiled)
     total = dof @ counting                             # [n, m] total DOF per output
     if in_use is not None:                   # where it is not in use, or not alone: no say
         for j, o in enumerate(compiled.outputs):
             total[~in_use.mask(o, X), j] = np.inf
     centres = None                                     # the same at the cells' centres
-    reported: dict[tuple, list[str]] = {}
     kinds: tuple[tuple[str, Callable[[np.ndarray], np.ndarray]], ...] = (
              ("no-rule-fires", lambda t: t <= 0.0),
              ("low-dof", lambda t: (t > 0.0) & (t < threshold)))
@@ -803,19 +819,7 @@ def _sampled(compiled: CompiledRuleBase, threshold: float, resolution: int,
         out += _exact_gaps(compiled, exact, span, missed)
         kinds = kinds[1:]
     for kind, mask_of in kinds:
-        reported.clear()
-        masks = {}
-        for j, out_name in enumerate(compiled.outputs):
-            mask = mask_of(total[:, j])
-            if not mask.any():
-                continue
-            # a declared `default: nan` is the rule base's own choice, as a number is
-            has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
-            key = (mask.tobytes(), has_default)
-            reported.setdefault(key, []).append(out_name)
-            masks[key] = mask
-        for key, outs in reported.items():
-            mask, has_default = masks[key], key[1]
+        for mask, has_default, outs in _gap_groups(compiled, total, mask_of):
             inner = kind == "no-rule-fires" and not skipped
             cells = None
             if inner and all(len(a) > 1 for a in axes):
@@ -833,17 +837,30 @@ def _sampled(compiled: CompiledRuleBase, threshold: float, resolution: int,
             if missed.intersection(outs):
                 message += (" (counting only the rules whose sets its sampling does not miss: "
                             "undersampled-term)")
-            out.append(Finding(severity, kind, message, span, name, hint,
+            out.append(Finding(severity, kind, message, span, compiled.behavior, hint,
                                tuple(boxes[:MAX_BOXES]), max(0, len(boxes) - MAX_BOXES), share,
                                uncovered))
+    return out
 
-    # rules that never fire: only the behavior's own (a used behavior's rules are judged in
-    # their own behavior, on its own, finer grid; here a `when` condition may silence them)
-    fires = (dof > 0.0).any(axis=0) if dof.shape[0] else np.zeros(compiled.n_rules, bool)
-    own = np.array([not contexts for _, _, contexts in flatten(compiled.rulebase, name)],
-                   dtype=bool)
-    out += _unreachable(compiled, np.flatnonzero(~fires & own), resolution)
-    return out, info
+
+def _gap_groups(compiled: CompiledRuleBase, total: np.ndarray,
+                mask_of: Callable[[np.ndarray], np.ndarray]
+                ) -> list[tuple[np.ndarray, bool, list[str]]]:
+    """The outputs' gaps (``mask_of`` each output's column of ``total [n, m]``), outputs
+    whose gaps are the same samples and alike in having a default grouped, so that one gap
+    is said once: each group's mask, whether its outputs have a default, and their names."""
+    reported: dict[tuple, list[str]] = {}
+    masks = {}
+    for j, out_name in enumerate(compiled.outputs):
+        mask = mask_of(total[:, j])
+        if not mask.any():
+            continue
+        # a declared `default: nan` is the rule base's own choice, as a number is
+        has_default = not np.isnan(compiled.default[j]) or declares_nan(compiled, out_name)
+        key = (mask.tobytes(), has_default)
+        reported.setdefault(key, []).append(out_name)
+        masks[key] = mask
+    return [(masks[key], key[1], outs) for key, outs in reported.items()]
 
 
 def _exact_gaps(compiled: CompiledRuleBase, exact: Exact, span: Span | None,

@@ -940,7 +940,17 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
     """``rb`` with every variable and term name the format ``fmt`` cannot hold (``LDL-Level``
     in FLL, ``service level`` in the rule language, a term named ``very``) mapped to a legal
     one (``LDL_Level``), and a note per renamed name."""
-    import dataclasses
+    var_map, term_map, notes = _legal_renames(rb, fmt)
+    if not notes:
+        return rb, []
+    return _renamed(rb, var_map, term_map), notes
+
+
+def _legal_renames(rb: RuleBase, fmt: str
+                   ) -> tuple[dict[str, str], dict[tuple[str, str], str], list[str]]:
+    """The new names of the variables and of each variable's terms that ``fmt`` cannot hold
+    (each new name unlike every other of its kind, so no two names merge), and a note per
+    renamed name saying why."""
     import re
 
     pattern = re.compile(NAME_PATTERNS.get(fmt, NAME_PATTERNS["fll"]))
@@ -978,9 +988,14 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
                 taken_terms.add(new_t)
                 notes.append(f"term `{v.name}.{t.name}` is written as `{new_t}` "
                              f"({FORMAT_TITLES[fmt]} cannot name it `{t.name}`)")
-    if not notes:
-        return rb, []
+    return var_map, term_map, notes
 
+
+def _renamed(rb: RuleBase, var_map: dict[str, str],
+             term_map: dict[tuple[str, str], str]) -> RuleBase:
+    """``rb`` with its variables and terms renamed (``var_map``; ``term_map``, keyed by the
+    old variable and term names) wherever they are named: term sets, rules, `use`
+    conditions."""
     def var(name: str) -> str:
         return var_map.get(name, name)
 
@@ -989,27 +1004,26 @@ def legal_names(rb: RuleBase, fmt: str) -> tuple[RuleBase, list[str]]:
 
     def expr(e: Expr) -> Expr:
         if isinstance(e, Prop):
-            return dataclasses.replace(e, var=var(e.var), term=term(e.var, e.term))
+            return replace(e, var=var(e.var), term=term(e.var, e.term))
         if isinstance(e, Not):
-            return dataclasses.replace(e, expr=expr(e.expr))
-        return dataclasses.replace(e, items=tuple(expr(i) for i in e.items))
+            return replace(e, expr=expr(e.expr))
+        return replace(e, items=tuple(expr(i) for i in e.items))
 
     def rule(r: Rule) -> Rule:
-        return dataclasses.replace(r, antecedent=expr(r.antecedent), consequents=tuple(
-            dataclasses.replace(c, var=var(c.var),
-                                term=None if c.term is None else term(c.var, c.term))
+        return replace(r, antecedent=expr(r.antecedent), consequents=tuple(
+            replace(c, var=var(c.var), term=None if c.term is None else term(c.var, c.term))
             for c in r.consequents))
 
-    termsets = tuple(TermSet(tuple(dataclasses.replace(
-        v, name=var(v.name), terms=tuple(dataclasses.replace(t, name=term(v.name, t.name))
+    termsets = tuple(TermSet(tuple(replace(
+        v, name=var(v.name), terms=tuple(replace(t, name=term(v.name, t.name))
                                          for t in v.terms)) for v in ts.variables), ts.path)
         for ts in rb.termsets)
-    behaviors = tuple(dataclasses.replace(
+    behaviors = tuple(replace(
         b, rules=tuple(rule(r) for r in b.rules),
-        uses=tuple(dataclasses.replace(u, condition=None if u.condition is None
-                                       else expr(u.condition)) for u in b.uses))
+        uses=tuple(replace(u, condition=None if u.condition is None else expr(u.condition))
+                   for u in b.uses))
         for b in rb.behaviors)
-    return dataclasses.replace(rb, termsets=termsets, behaviors=behaviors), notes
+    return replace(rb, termsets=termsets, behaviors=behaviors)
 
 
 # ---------------------------------------------------------------------------------------------

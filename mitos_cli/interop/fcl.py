@@ -520,6 +520,10 @@ def _variable(node: Tree, role: Role, declared: Declared, settings: common.Recor
               constants: list, n_inputs: int, span_of: SpanOf, notes: list[str],
               ranges: common.Places | None = None,
               known: dict[str, Variable] | None = None) -> Variable:
+    """A FUZZIFY or DEFUZZIFY block as a :class:`Variable`, checked against its declaration
+    (``declared``); its output settings go to ``settings``, its `LOCK : RANGE` to ``locks``,
+    its constant output terms to ``constants`` and where it writes RANGE and DEFAULT to
+    ``ranges``."""
     name_token = node.children[0]
     name = str(name_token)
     if name not in declared:
@@ -552,36 +556,64 @@ def _variable(node: Tree, role: Role, declared: Declared, settings: common.Recor
                 raise FormatError(f"`{key}` has no meaning in FUZZIFY", span=span_of(item))
             _option(item, settings, span_of, {}, notes)
         elif kind == "default_item":
-            value, flag = item.children
-            if flag is not None:
-                if str(flag).upper() == "NC":
-                    raise FormatError("`| NC` (no change: keep the previous output when no rule "
-                                      "fires) needs state between evaluations, which MITOS does "
-                                      "not keep", span=span_of(flag),
-                                      hint="give a plain `DEFAULT := value;`")
-                raise FormatError(f"unknown DEFAULT flag `{flag}`", span=span_of(flag),
-                                  expected="NC")
-            if isinstance(value, Token) and value.type == "NAME":
-                if str(value).upper() == "NC":
-                    raise FormatError("`DEFAULT := NC` (no change: keep the previous output "
-                                      "when no rule fires) needs state between evaluations, "
-                                      "which MITOS does not keep", span=span_of(value),
-                                      hint="give a number: `DEFAULT := value;`")
-                raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
-            default = _num(value)              # nan: NaN when no rule fires, as asked
+            default = _default(item, span_of)   # nan: NaN when no rule fires, as asked
             if ranges is not None:
                 ranges[name, "default"] = span_of(item)
         elif kind == "lock_item":
             for word in item.children:
-                w = str(word).upper()
-                if w == "PREVIOUS":
-                    raise FormatError("`LOCK : PREVIOUS` (keep the previous output when no rule "
-                                      "fires) needs state between evaluations, which MITOS does "
-                                      "not keep", span=span_of(word))
-                if w != "RANGE":
-                    raise FormatError(f"unknown LOCK `{word}`", span=span_of(word),
-                                      expected="PREVIOUS or RANGE")
-                locks[name] = span_of(word)
+                locks[name] = _lock_range(word, span_of)
+    lo, hi = _universe(node, name, role, universe, terms, declared, default, span_of, notes,
+                       known)
+    try:
+        return Variable(name, role, (lo, hi), tuple(terms), "", "", default, span_of(name_token))
+    except Exception as exc:                     # duplicate terms: TermSetError with a span
+        raise FormatError(getattr(exc, "message", str(exc)),
+                          span=getattr(exc, "span", None) or span_of(node)) from None
+
+
+def _default(item: Tree, span_of: SpanOf) -> float:
+    """A `DEFAULT := value;` item's value; `NC` and the `| NC` flag are refused: keeping the
+    previous output needs state between evaluations, which MITOS does not keep."""
+    value, flag = item.children
+    if flag is not None:
+        if str(flag).upper() == "NC":
+            raise FormatError("`| NC` (no change: keep the previous output when no rule "
+                              "fires) needs state between evaluations, which MITOS does "
+                              "not keep", span=span_of(flag),
+                              hint="give a plain `DEFAULT := value;`")
+        raise FormatError(f"unknown DEFAULT flag `{flag}`", span=span_of(flag),
+                          expected="NC")
+    if isinstance(value, Token) and value.type == "NAME":
+        if str(value).upper() == "NC":
+            raise FormatError("`DEFAULT := NC` (no change: keep the previous output "
+                              "when no rule fires) needs state between evaluations, "
+                              "which MITOS does not keep", span=span_of(value),
+                              hint="give a number: `DEFAULT := value;`")
+        raise FormatError(f"DEFAULT must be a number, not `{value}`", span=span_of(value))
+    return _num(value)
+
+
+def _lock_range(word: Node, span_of: SpanOf) -> Span:
+    """Where a `LOCK` word says RANGE (the output is clipped to its range); `PREVIOUS` is
+    refused (it needs state between evaluations, which MITOS does not keep), as is any
+    other word."""
+    w = str(word).upper()
+    if w == "PREVIOUS":
+        raise FormatError("`LOCK : PREVIOUS` (keep the previous output when no rule "
+                          "fires) needs state between evaluations, which MITOS does "
+                          "not keep", span=span_of(word))
+    if w != "RANGE":
+        raise FormatError(f"unknown LOCK `{word}`", span=span_of(word),
+                          expected="PREVIOUS or RANGE")
+    return span_of(word)
+
+
+def _universe(node: Tree, name: str, role: Role, universe: tuple[float, float] | None,
+              terms: list[Term], declared: Declared, default: float | None, span_of: SpanOf,
+              notes: list[str], known: dict[str, Variable] | None) -> tuple[float, float]:
+    """The variable's range: as declared or written (RANGE), else where jFuzzyLogic puts it,
+    from its terms (:func:`_linear_extent` for linear output terms, :func:`_extent`); a
+    variable without terms or with an empty range is refused."""
     if not terms and (role == "output" or universe is None):
         raise FormatError(f"variable `{name}` has no terms", span=span_of(node),
                           hint=None if role == "output" else "an input without terms (it only "
@@ -596,11 +628,7 @@ def _variable(node: Tree, role: Role, declared: Declared, settings: common.Recor
     if not lo < hi:
         raise FormatError(f"variable `{name}`: range [{lo:g}, {hi:g}] is empty",
                           span=span_of(node))
-    try:
-        return Variable(name, role, (lo, hi), tuple(terms), "", "", default, span_of(name_token))
-    except Exception as exc:                     # duplicate terms: TermSetError with a span
-        raise FormatError(getattr(exc, "message", str(exc)),
-                          span=getattr(exc, "span", None) or span_of(node)) from None
+    return lo, hi
 
 
 #: Where jFuzzyLogic's ``estimateUniverse`` puts the ends of a term with unbounded support,

@@ -84,19 +84,8 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
         if isinstance(expr, Prop):
             if expr.var not in outputs:
                 return expr
-            found = sources.get((expr.var, expr.term), [])
-            if not found:
-                raise FormatError(f"rule `{rule.label}` tests `{expr.var} is {expr.term}`, "
-                                  f"which no rule before it sets (always 0 in fuzzylite)",
-                                  span=expr.span or rule.span,
-                                  hint="move the rules that set it before this one")
-            if len(found) > 1 and aggregation != or_:
-                raise FormatError(
-                    f"rule `{rule.label}` tests the output `{expr.var}`, which aggregates "
-                    f"{len(found)} rules with `{aggregation or 'sum'}`; MITOS "
-                    f"can restate that only when the rule block's disjunction is the same "
-                    f"(here `{or_}`)", span=expr.span or rule.span)
-            joined = found[0] if len(found) == 1 else Or(tuple(found), expr.span)
+            joined = _setters(expr, rule, sources.get((expr.var, expr.term), []), aggregation,
+                              or_)
             charge(joined, rule, expr)
             hedged = push_hedges(joined, expr.hedges, and_, or_, rule,
                                  "a hedge on a chained output")
@@ -109,14 +98,7 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
         antecedent = expand(rule.antecedent, rule)
         if antecedent != rule.antecedent:
             chained += 1
-            depth = _size(antecedent, sizes)[0]
-            if depth > MAX_NESTING:
-                raise FormatError(
-                    f"rule `{rule.label}` tests chained outputs: written out, its condition "
-                    f"nests {depth} deep, more than {MAX_NESTING}", span=rule.span,
-                    hint="MITOS restates each tested output as the conditions of the rules "
-                         "that set it, which adds their nesting at each step of the chain; "
-                         "shorten the chain")
+            _check_nesting(rule, _size(antecedent, sizes)[0])
             rule = Rule(rule.label, antecedent, rule.consequents, rule.weight, rule.span)
         for c in rule.consequents:
             if c.term is None or c.var not in outputs:
@@ -133,6 +115,38 @@ def unchain(rules: list[Rule], outputs: set[str], and_: str, or_: str,
                      f"conditions of the earlier rules that set that term, which is what "
                      f"fuzzylite computes")
     return out
+
+
+def _setters(expr: Prop, rule: Rule, found: list[Expr], aggregation: str | None,
+             or_: str) -> Expr:
+    """The conditions ``found`` of the earlier rules that set the output term ``expr`` tests,
+    joined by the rule block's disjunction, which is what fuzzylite's aggregation computes
+    only when the two are the same (or one rule sets it); refused otherwise, and when no
+    rule before sets it (fuzzylite reads 0 there, which is surely not what was meant)."""
+    if not found:
+        raise FormatError(f"rule `{rule.label}` tests `{expr.var} is {expr.term}`, "
+                          f"which no rule before it sets (always 0 in fuzzylite)",
+                          span=expr.span or rule.span,
+                          hint="move the rules that set it before this one")
+    if len(found) > 1 and aggregation != or_:
+        raise FormatError(
+            f"rule `{rule.label}` tests the output `{expr.var}`, which aggregates "
+            f"{len(found)} rules with `{aggregation or 'sum'}`; MITOS "
+            f"can restate that only when the rule block's disjunction is the same "
+            f"(here `{or_}`)", span=expr.span or rule.span)
+    return found[0] if len(found) == 1 else Or(tuple(found), expr.span)
+
+
+def _check_nesting(rule: Rule, depth: int) -> None:
+    """Refuse a rewritten condition nested ``depth`` deep past :data:`MAX_NESTING`: the rule
+    language reads no deeper, and every later pass walks conditions recursively."""
+    if depth > MAX_NESTING:
+        raise FormatError(
+            f"rule `{rule.label}` tests chained outputs: written out, its condition "
+            f"nests {depth} deep, more than {MAX_NESTING}", span=rule.span,
+            hint="MITOS restates each tested output as the conditions of the rules "
+                 "that set it, which adds their nesting at each step of the chain; "
+                 "shorten the chain")
 
 
 def _size(expr: Expr, memo: dict[int, tuple[Expr, int, int]]) -> tuple[int, int]:

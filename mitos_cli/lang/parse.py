@@ -123,41 +123,14 @@ def _describe(token: Token) -> str:
 def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSyntaxError:
     """Lark's exception as a user-facing error (never ``$END`` or ``Token(...)``)."""
     if isinstance(exc, UnexpectedCharacters):
-        line, column = exc.line, exc.column
-        pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
-        char = text[pos] if pos < len(text) else ""
-        message = f"unexpected character `{char}`" if char.isprintable() else \
-            f"unexpected character {char!r}"
-        allowed = _expected(exc.allowed) if exc.allowed else None
-        hint = None
-        if char.isalpha() and not char.isascii():     # `température`: names are ASCII
-            hint = ("names are ASCII letters, digits, `_` and `-` (`temperature`); other text "
-                    "belongs in a term set's `description`")
-        elif char == ";":                               # FCL's `... then speed is SLOW;`
-            hint = ("a rule needs no `;` at its end (FCL's rules have one: `mitos convert "
-                    "FILE.fcl --to rules` reads an FCL file)")
-        return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
-                               expected=allowed, hint=hint)
+        return _character_error(exc, text, path)
     if isinstance(exc, UnexpectedInput):
         negated = not_in_action_before(exc, text, path)
         if negated is not None:
             return negated
-    if isinstance(exc, UnexpectedToken) and exc.token.type == "$END":
-        stray = _stray_label(exc, text, path)
-        if isinstance(stray, RuleSyntaxError):
-            return stray
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
-        lines = lines_of(text.rstrip()) or [""]
-        line = len(lines)
-        column = len(lines[-1]) + 1
-        names = getattr(exc, "expected", None) or []
-        return RuleSyntaxError("unexpected end of the input",
-                               span=Span.in_text(text, path, line, column),
-                               expected=_expected(names) if names else None,
-                               hint=_statement_hint(text, len(text.rstrip())) or
-                               "the last rule or behavior is incomplete (a behavior ends "
-                               "with `end`)")
+        return _end_error(exc, text, path)
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
     cut = _operators_cut_short(text, path, token.line)
@@ -178,34 +151,79 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         return _glued_is_error(text, path, glued.group(1), glued.start(2), glued.end(2), None)
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
-    hint = None
     expected = set(exc.expected)
+    hint = _token_hint(text, token, expected)
+    hint = _statement_hint(text, token.start_pos) or stray or hint
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(expected), hint=hint)
+
+
+def _character_error(exc: UnexpectedCharacters, text: str, path: str | None
+                     ) -> RuleSyntaxError:
+    """A character the lexer cannot start a token with, with a hint where one is a common
+    slip (a name in non-ASCII letters, FCL's `;` at a rule's end)."""
+    line, column = exc.line, exc.column
+    pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
+    char = text[pos] if pos < len(text) else ""
+    message = f"unexpected character `{char}`" if char.isprintable() else \
+        f"unexpected character {char!r}"
+    allowed = _expected(exc.allowed) if exc.allowed else None
+    hint = None
+    if char.isalpha() and not char.isascii():     # `température`: names are ASCII
+        hint = ("names are ASCII letters, digits, `_` and `-` (`temperature`); other text "
+                "belongs in a term set's `description`")
+    elif char == ";":                               # FCL's `... then speed is SLOW;`
+        hint = ("a rule needs no `;` at its end (FCL's rules have one: `mitos convert "
+                "FILE.fcl --to rules` reads an FCL file)")
+    return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
+                           expected=allowed, hint=hint)
+
+
+def _end_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSyntaxError:
+    """The input ended before a statement did: said at the end of its last non-blank line
+    (LALR reports the end as a token, ``$END``, that users must never read), unless a label
+    stands there alone (:func:`_stray_label`)."""
+    if isinstance(exc, UnexpectedToken) and exc.token.type == "$END":
+        stray = _stray_label(exc, text, path)
+        if isinstance(stray, RuleSyntaxError):
+            return stray
+    lines = lines_of(text.rstrip()) or [""]
+    line = len(lines)
+    column = len(lines[-1]) + 1
+    names = getattr(exc, "expected", None) or []
+    return RuleSyntaxError("unexpected end of the input",
+                           span=Span.in_text(text, path, line, column),
+                           expected=_expected(names) if names else None,
+                           hint=_statement_hint(text, len(text.rstrip())) or
+                           "the last rule or behavior is incomplete (a behavior ends "
+                           "with `end`)")
+
+
+def _token_hint(text: str, token: Token, expected: set[str]) -> str | None:
+    """What an unexpected ``token`` most likely means, from what the parser ``expected``
+    there: a keyword read as a name, `=` for `is`, a misspelt keyword, conditions not joined
+    or a missing `then`."""
     if token.type == "NAME" and "IS" in expected:
         before = _word_before(text, token)
         close = did_you_mean(before, RESERVED) if before else None
         if before in RESERVED:
             # `if road is WIDE and then ...`: the keyword was read as a variable's name
-            hint = (f"`{before}` stands where a condition should be; a condition reads "
+            return (f"`{before}` stands where a condition should be; a condition reads "
                     f"`variable is TERM`")
-        elif close and not _after_connective(text, token):
+        if close and not _after_connective(text, token):
             # `r1: iff road is WIDE ...`: `iff` was read as a variable's name (but in
             # `if temp COLD`, `temp` is one: not "did you mean `terms`")
-            hint = f"`{before}` is read as a variable's name: {close}"
-        else:
-            hint = "a condition reads `variable is TERM`"
-    elif str(token.value) == "=" and "IS" in expected and _word_before(text, token):
+            return f"`{before}` is read as a variable's name: {close}"
+        return "a condition reads `variable is TERM`"
+    if str(token.value) == "=" and "IS" in expected and _word_before(text, token):
         # `then speed = 5`: a proposition is `speed is 5`, not an assignment
-        hint = f"write `{_word_before(text, token)} is ...`: a condition or action reads " \
+        return f"write `{_word_before(text, token)} is ...`: a condition or action reads " \
                f"`variable is TERM` (or `is 5` for a crisp value), not `=`"
-    elif "THEN" in expected and token.type in ("NAME",):
-        hint = _keyword_as_term(text, token) or _hedge_hint(text, token) or \
+    if "THEN" in expected and token.type in ("NAME",):
+        return _keyword_as_term(text, token) or _hedge_hint(text, token) or \
             keyword_hint(token, expected) or _two_words(text, token) or \
             "join conditions with `and` / `or`, and start the actions with `then`"
-    else:
-        hint = keyword_hint(token, expected) or _joined_with_comma(text, token)
-    hint = _statement_hint(text, token.start_pos) or stray or hint
-    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
-                           expected=_expected(expected), hint=hint)
+    return keyword_hint(token, expected) or _joined_with_comma(text, token)
 
 
 #: a line that begins a statement: a keyword, or a label and its colon

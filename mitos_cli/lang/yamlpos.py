@@ -128,75 +128,94 @@ _Yaml12Scalars.add_constructor(_FLOAT, _construct_float)
 _Yaml12Scalars.add_constructor(YAML11_BOOL, _construct_text)
 
 
+def _unsupported(event: yaml.Event) -> yaml.constructor.ConstructorError | None:
+    """The refusal of an alias, an anchor or a tag at ``event`` (no format here has them, and
+    an alias bomb expands a few lines into billions of values), or ``None``. A quoted string
+    keeps the tag ``!!str`` the parser gives it, and ``!`` (a plain non-specific tag) is no
+    tag."""
+    if isinstance(event, yaml.AliasEvent):
+        return _refuse(f"aliases (`*{event.anchor}`) are not supported here; write "
+                       f"the value out", event.start_mark)
+    anchor = getattr(event, "anchor", None)
+    if anchor is not None:
+        return _refuse(f"anchors (`&{anchor}`) are not supported here", event.start_mark)
+    tag = getattr(event, "tag", None)
+    if tag is not None and tag != "!" and not (
+            isinstance(event, yaml.ScalarEvent) and not event.implicit[0]
+            and tag == "tag:yaml.org,2002:str"):
+        shown = tag.replace("tag:yaml.org,2002:", "!!")
+        return _refuse(f"YAML tags (`{shown}`) are not supported here", event.start_mark)
+    return None
+
+
+def _key_refusal(key_node: yaml.Node) -> yaml.constructor.ConstructorError | None:
+    """The refusal of a mapping key that is not a plain name: a list or mapping, a merge key
+    (`<<`), or a word YAML 1.1 reads as a boolean, a number or null (``ON``, ``1e3``, ``~``:
+    the key the user wrote would be lost); ``None`` for a plain name."""
+    if not isinstance(key_node, yaml.ScalarNode):
+        return _refuse("a mapping key must be a plain name", key_node.start_mark)
+    if key_node.tag == "tag:yaml.org,2002:merge":
+        return _refuse("merge keys (`<<`) are not supported here; write the keys out",
+                       key_node.start_mark)
+    if key_node.tag != "tag:yaml.org,2002:str":
+        kind = key_node.tag.rsplit(":", 1)[-1]
+        kind = {"bool": "true/false", "yaml11-bool": "true/false",
+                "null": "null"}.get(kind, "a number")
+        return _refuse(f"the key `{key_node.value}` reads as {kind} in YAML; "
+                       f"write it in quotes: \"{key_node.value}\"", key_node.start_mark)
+    return None
+
+
+class _SafeLoader(_Yaml12Scalars):
+    """Safe loading without aliases, anchors, merge keys or tags (no format here has
+    them, and an alias bomb expands a few lines into billions of values), nested at most
+    :data:`MAX_DEPTH` deep, of at most :data:`MAX_NODES` values, and with the
+    constructors' own errors kept at their node."""
+
+    depth = 0
+    nodes = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
+        event = self.peek_event()
+        refused = _unsupported(event)
+        if refused is not None:
+            raise refused
+        self.nodes += 1
+        if self.nodes > MAX_NODES:
+            raise _refuse(f"more than {MAX_NODES:,} values, far more than any term set, "
+                          f"world or map file holds", event.start_mark)
+        self.depth += 1
+        try:
+            if self.depth > MAX_DEPTH:
+                raise _refuse(f"nested more than {MAX_DEPTH} levels deep",
+                              event.start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:   # any YAML value
+        try:
+            return super().construct_object(node, deep)
+        except yaml.YAMLError:
+            raise
+        except (ValueError, TypeError, KeyError, AttributeError, OverflowError):
+            kind = node.tag.rsplit(":", 1)[-1]
+            raise _refuse(f"`{node.value}` cannot be read as {kind}", node.start_mark
+                          ) from None
+
+
 def _build_loader(text: str, path: str | None) -> type:
-    class Loader(_Yaml12Scalars):
-        """Safe loading without aliases, anchors, merge keys or tags (no format here has
-        them, and an alias bomb expands a few lines into billions of values), nested at most
-        :data:`MAX_DEPTH` deep, of at most :data:`MAX_NODES` values, and with the
-        constructors' own errors kept at their node."""
-
-        depth = 0
-        nodes = 0
-
-        def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
-            event = self.peek_event()
-            if isinstance(event, yaml.AliasEvent):
-                raise _refuse(f"aliases (`*{event.anchor}`) are not supported here; write "
-                              f"the value out", event.start_mark)
-            if getattr(event, "anchor", None) is not None:
-                raise _refuse(f"anchors (`&{event.anchor}`) are not supported here",
-                              event.start_mark)
-            tag = getattr(event, "tag", None)
-            if tag is not None and tag != "!" and not (
-                    isinstance(event, yaml.ScalarEvent) and not event.implicit[0]
-                    and tag == "tag:yaml.org,2002:str"):
-                shown = tag.replace("tag:yaml.org,2002:", "!!")
-                raise _refuse(f"YAML tags (`{shown}`) are not supported here",
-                              event.start_mark)
-            self.nodes += 1
-            if self.nodes > MAX_NODES:
-                raise _refuse(f"more than {MAX_NODES:,} values, far more than any term set, "
-                              f"world or map file holds", event.start_mark)
-            self.depth += 1
-            try:
-                if self.depth > MAX_DEPTH:
-                    raise _refuse(f"nested more than {MAX_DEPTH} levels deep",
-                                  event.start_mark)
-                return super().compose_node(parent, index)
-            finally:
-                self.depth -= 1
-
-        def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:   # any YAML value
-            try:
-                return super().construct_object(node, deep)
-            except yaml.YAMLError:
-                raise
-            except (ValueError, TypeError, KeyError, AttributeError, OverflowError):
-                kind = node.tag.rsplit(":", 1)[-1]
-                raise _refuse(f"`{node.value}` cannot be read as {kind}", node.start_mark
-                              ) from None
-
-    def construct_mapping(loader: Loader, node: yaml.MappingNode) -> YMap:
+    """A :class:`_SafeLoader` for ``text`` (read from ``path``) whose mappings and lists know
+    where each of their keys and items is written (:class:`YMap`, :class:`YList`)."""
+    def construct_mapping(loader: _SafeLoader, node: yaml.MappingNode) -> YMap:
         out = YMap()
         out.span = _span(node.start_mark, text, path)
         out.end_span = _span(node.end_mark, text, path)
         out.key_spans, out.value_spans = {}, {}
         for key_node, value_node in node.value:
-            if not isinstance(key_node, yaml.ScalarNode):
-                raise yaml.constructor.ConstructorError(
-                    None, None, "a mapping key must be a plain name", key_node.start_mark)
-            if key_node.tag == "tag:yaml.org,2002:merge":
-                raise yaml.constructor.ConstructorError(
-                    None, None, "merge keys (`<<`) are not supported here; write the keys out",
-                    key_node.start_mark)
-            if key_node.tag != "tag:yaml.org,2002:str":
-                # YAML 1.1 reads ON, off, yes, No, 1e3, ~ ... as booleans, numbers, null
-                kind = key_node.tag.rsplit(":", 1)[-1]
-                kind = {"bool": "true/false", "yaml11-bool": "true/false",
-                        "null": "null"}.get(kind, "a number")
-                raise yaml.constructor.ConstructorError(
-                    None, None, f"the key `{key_node.value}` reads as {kind} in YAML; "
-                    f"write it in quotes: \"{key_node.value}\"", key_node.start_mark)
+            refused = _key_refusal(key_node)
+            if refused is not None:
+                raise refused
             key = loader.construct_object(key_node, deep=True)
             if key in out:
                 raise yaml.constructor.ConstructorError(
@@ -206,11 +225,14 @@ def _build_loader(text: str, path: str | None) -> type:
             out.value_spans[key] = _span(value_node.start_mark, text, path)
         return out
 
-    def construct_sequence(loader: Loader, node: yaml.SequenceNode) -> YList:
+    def construct_sequence(loader: _SafeLoader, node: yaml.SequenceNode) -> YList:
         out = YList(loader.construct_object(child, deep=True) for child in node.value)
         out.span = _span(node.start_mark, text, path)
         out.item_spans = [_span(child.start_mark, text, path) for child in node.value]
         return out
+
+    class Loader(_SafeLoader):
+        pass
 
     Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
     Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, construct_sequence)

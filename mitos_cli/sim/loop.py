@@ -1704,18 +1704,12 @@ class Batch:
                        if self._keeps_rows else [])
         self._goal_x, self._goal_y, self._tol = (self._gather(name)
                                                  for name in ("_goal_x", "_goal_y", "_tol"))
-        # whether each robot drives, and its safety.Recovery: the batch's arrays, each run's
-        # its views of them (both are written in place, by the run alone or by the batch)
-        self._active, self._recovery = self._gather("_active"), self._gather("_recovery")
-        for run, active, recovery in zip(runs, self._each(self._active),
-                                         self._each(self._recovery)):
-            run._active, run._recovery = active, recovery
+        # whether each robot drives, its safety.Recovery and its route length
+        # (Simulation.replanned writes it), shared; what the runs had driven after the
+        # batch's last moves
+        self._active, self._recovery = self._share("_active"), self._share("_recovery")
         self._straight = np.concatenate([run.limits.straight for run in runs])
-        # each robot's route length: the batch's array, each run's its view (Simulation.replanned
-        # writes it in place), and what the runs had driven after the batch's last moves
-        self._lengths = self._gather("_lengths")
-        for run, lengths in zip(runs, self._each(self._lengths)):
-            run._lengths = lengths
+        self._lengths = self._share("_lengths")
         self._trail: list[tuple[np.ndarray, np.ndarray]] = []
         self.stacked: rows.Kept = {}        # what its last rows.sense stacked of the runs' rows
         self.maps = [m for run in runs for m in run._maps]
@@ -1783,6 +1777,15 @@ class Batch:
     def _gather(self, name: str) -> np.ndarray:
         """The runs' arrays ``name`` one after the other (a fresh array)."""
         return np.concatenate([getattr(run, name) for run in self.runs])
+
+    def _share(self, name: str) -> np.ndarray:
+        """The runs' arrays ``name`` gathered into one of the batch's, each run given its
+        view of it in place of its own: written in place only from then on, by the run alone
+        or by the batch, both see every change."""
+        whole = self._gather(name)
+        for run, view in zip(self.runs, self._each(whole)):
+            setattr(run, name, view)
+        return whole
 
     def _each(self, rows: np.ndarray) -> list[np.ndarray]:
         """Each run's rows of ``rows [robots, ...]``, views, one run after the other (a robot

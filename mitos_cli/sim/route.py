@@ -405,6 +405,37 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
     widest way (:class:`NarrowPassage`; ``half_width``: the robot's, for what it suggests)."""
     segs = [(np.asarray(a, float), np.asarray(b, float), c.width)
             for c in corridors for a, b in zip(c.points[:-1], c.points[1:])]
+    splits = _crossings(segs)
+    ends = []
+    for xy in ((start.x, start.y), (goal.x, goal.y)):
+        best = _nearest_on(segs, np.asarray(xy, float))
+        if best is None:
+            raise WorldError("the map has no corridors to route along",
+                             hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
+        splits[best[1]].add(best[2])
+        ends.append(best)
+    adj, coords, (s_id, g_id) = _centre_graph(segs, splits, ends)
+    room = _edge_room(adj, coords, walls)
+    path = _astar(lambda n: [(v, step) for v, step in adj.get(n, []) if room[n, v] >= least],
+                  s_id, g_id, lambda n: coords[n])
+    if path is None:
+        if _astar(lambda n: adj.get(n, []), s_id, g_id, lambda n: coords[n]) is None:
+            raise WorldError("the corridors do not connect the start to the goal",
+                             hint="join the corridors: a route follows their centre lines")
+        assert walls is not None            # without walls every edge has room
+        raise _narrow_corridor(adj, coords, room, s_id, g_id, walls, least, half_width)
+    # the route runs from the start's to the goal's projection onto the centre lines; the
+    # goal itself is kept apart (perception steers for it over the last lookahead)
+    return Route.of([coords[n] for n in path], goal=(goal.x, goal.y))
+
+
+#: A centre line's segment: its ends and its corridor's width (in).
+_Segment = tuple[np.ndarray, np.ndarray, float]
+
+
+def _crossings(segs: list[_Segment]) -> list[set[float]]:
+    """Where each segment meets another, as fractions along it (with its ends, 0 and 1): the
+    centre lines' graph joins corridors at these points, so a route can turn there."""
     splits = [{0.0, 1.0} for _ in segs]
     for i, (a, b, _) in enumerate(segs):
         for j in range(i + 1, len(segs)):
@@ -419,21 +450,29 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
             if -1e-9 <= t <= 1 + 1e-9 and -1e-9 <= u <= 1 + 1e-9:
                 splits[i].add(min(max(t, 0.0), 1.0))
                 splits[j].add(min(max(u, 0.0), 1.0))
-    ends = []
-    for xy in ((start.x, start.y), (goal.x, goal.y)):
-        p = np.asarray(xy, float)
-        best = None
-        for i, (a, b, _) in enumerate(segs):
-            e = b - a
-            t = float(np.clip(np.dot(p - a, e) / max(np.dot(e, e), 1e-12), 0, 1))
-            dist = float(np.hypot(*(a + t * e - p)))
-            if best is None or dist < best[0]:
-                best = (dist, i, t)
-        if best is None:
-            raise WorldError("the map has no corridors to route along",
-                             hint="add `corridors: [{points: [[0, 0], [600, 0]], width: 70}]`")
-        splits[best[1]].add(best[2])
-        ends.append(best)
+    return splits
+
+
+def _nearest_on(segs: list[_Segment], p: np.ndarray) -> tuple[float, int, float] | None:
+    """The point of the centre lines nearest ``p`` (a start or a goal), as its distance, its
+    segment and the fraction along it: the route starts or ends there (``None``: no
+    segments)."""
+    best: tuple[float, int, float] | None = None
+    for i, (a, b, _) in enumerate(segs):
+        e = b - a
+        t = float(np.clip(np.dot(p - a, e) / max(np.dot(e, e), 1e-12), 0, 1))
+        dist = float(np.hypot(*(a + t * e - p)))
+        if best is None or dist < best[0]:
+            best = (dist, i, t)
+    return best
+
+
+def _centre_graph(segs: list[_Segment], splits: list[set[float]],
+                  ends: list[tuple[float, int, float]]
+                  ) -> tuple[dict[int, list[tuple[int, float]]], list[np.ndarray], list[int]]:
+    """The centre lines as a graph for :func:`_astar`: each segment cut at its ``splits``,
+    a point shared by segments one node (its coordinates rounded to 1e-6 in), each edge both
+    ways with its length; and the nodes of ``ends`` (:func:`_nearest_on`'s)."""
     keys: dict[tuple, int] = {}
     coords: list[np.ndarray] = []
 
@@ -451,19 +490,7 @@ def corridor_route(corridors: tuple[Corridor, ...], start: Pose, goal: Goal,
             step = float(math.dist(coords[u], coords[v]))
             adj.setdefault(u, []).append((v, step))
             adj.setdefault(v, []).append((u, step))
-    s_id, g_id = (node(segs[i][0] + t * (segs[i][1] - segs[i][0])) for _, i, t in ends)
-    room = _edge_room(adj, coords, walls)
-    path = _astar(lambda n: [(v, step) for v, step in adj.get(n, []) if room[n, v] >= least],
-                  s_id, g_id, lambda n: coords[n])
-    if path is None:
-        if _astar(lambda n: adj.get(n, []), s_id, g_id, lambda n: coords[n]) is None:
-            raise WorldError("the corridors do not connect the start to the goal",
-                             hint="join the corridors: a route follows their centre lines")
-        assert walls is not None            # without walls every edge has room
-        raise _narrow_corridor(adj, coords, room, s_id, g_id, walls, least, half_width)
-    # the route runs from the start's to the goal's projection onto the centre lines; the
-    # goal itself is kept apart (perception steers for it over the last lookahead)
-    return Route.of([coords[n] for n in path], goal=(goal.x, goal.y))
+    return adj, coords, [node(segs[i][0] + t * (segs[i][1] - segs[i][0])) for _, i, t in ends]
 
 
 def _edge_room(adj: dict[int, list[tuple[int, float]]], coords: list[np.ndarray],

@@ -33,6 +33,7 @@ from ..words import plural
 from .spec import KEY_FIELDS, Task
 
 if TYPE_CHECKING:
+    import _csv
     from collections.abc import Callable
 
 #: what a run reports, in this order, after the key and the seed (``replans``: routes planned
@@ -173,6 +174,26 @@ class ResultStore:
         if not self.path.exists():
             return []
         _refuse_special(self.path, "results file")
+        data, text = self._whole_lines()
+        if not text:
+            return []
+        reader = csv.reader(io.StringIO(text, newline=""))
+        try:
+            self.columns = self._header(next(reader), text)
+            rows = self._runs(reader, text, data)
+            self._refuse_twice(rows)
+            return rows
+        except csv.Error as exc:               # a field past csv's limit
+            line_no = reader.line_num
+            line = text.splitlines()[line_no - 1] if line_no else ""
+            raise StudyError(f"line {line_no} is not a row of results ({exc})",
+                             span=Span(str(self.path), line_no, 1, line[:200]),
+                             hint="the file was edited by hand; remove that line") from None
+
+    def _whole_lines(self) -> tuple[bytes, str]:
+        """The file's bytes and its text up to the end of its last whole line: a last line
+        without its newline is kept (with one) when it is a whole row, as an editor saves a
+        file, and is left out when a kill cut it short (:meth:`_mend` cuts it off later)."""
         try:
             data = self.path.read_bytes()
             cut = data.rfind(b"\n") + 1
@@ -186,53 +207,51 @@ class ResultStore:
             text, self._unended = text + last + "\n", True
         elif cut < len(data):                              # killed in the middle of a row
             self._keep = cut
-        if not text:
-            return []
-        reader = csv.reader(io.StringIO(text, newline=""))
-        try:
-            header = next(reader)
-            top = Span(str(self.path), 1, 1, text.splitlines()[0][:200])   # (the header's line)
-            if tuple(header) == COLUMNS_BEFORE_REPLANS:
-                raise StudyError(f"{self.path} was written by an earlier version of mitos: its "
-                                 f"rows have no replans and backouts, which this version "
-                                 f"reports for every run", span=top,
-                                 hint="run the study again in another directory with -o")
-            if tuple(header) not in (COLUMNS, FLEET_COLUMNS):
-                raise StudyError(f"{self.path} is not a results file of this version of mitos",
-                                 span=top, expected="the columns " + ",".join(COLUMNS)
-                                 + " (with `robot` after `run` in a study of several robots)",
-                                 hint="choose another output directory with -o")
-            self.columns = tuple(header)
-            lines, rows, self._at = text.splitlines(), [], []
-            robots: list[tuple[dict, tuple[int, str, list[str]]]] = []   # before their run's
-            ended = reader.line_num                        # the line the last run's rows end on
-            for values in reader:
-                line_no = reader.line_num                  # (a row's last line)
-                at = (line_no, lines[line_no - 1], values)
-                row = self._row(*at)
-                name = row.pop("robot", "")
-                if robots and key_of(robots[0][0]) != key_of(row):
-                    self._orphans(robots)
-                if name:
-                    self._robot_once(robots, row, name, at)
-                    robots.append(({**row, "robot": name}, at))
-                    continue
-                if robots:
-                    row["robots"] = self._robots_of(row, at, robots)
-                    robots = []
-                rows.append(row)
-                self._at.append(at)
-                ended = line_no
-            if robots:       # a run's robots without the run's own row: killed as they were
-                self._keep, self._unended = _line_end(data, ended), False      # written
-            self._refuse_twice(rows)
-            return rows
-        except csv.Error as exc:               # a field past csv's limit
-            line_no = reader.line_num
-            line = text.splitlines()[line_no - 1] if line_no else ""
-            raise StudyError(f"line {line_no} is not a row of results ({exc})",
-                             span=Span(str(self.path), line_no, 1, line[:200]),
-                             hint="the file was edited by hand; remove that line") from None
+        return data, text
+
+    def _header(self, header: list[str], text: str) -> tuple[str, ...]:
+        """The file's columns, refused unless this version wrote them (a file of an earlier
+        version lacks figures every run reports now)."""
+        top = Span(str(self.path), 1, 1, text.splitlines()[0][:200])   # (the header's line)
+        if tuple(header) == COLUMNS_BEFORE_REPLANS:
+            raise StudyError(f"{self.path} was written by an earlier version of mitos: its "
+                             f"rows have no replans and backouts, which this version "
+                             f"reports for every run", span=top,
+                             hint="run the study again in another directory with -o")
+        if tuple(header) not in (COLUMNS, FLEET_COLUMNS):
+            raise StudyError(f"{self.path} is not a results file of this version of mitos",
+                             span=top, expected="the columns " + ",".join(COLUMNS)
+                             + " (with `robot` after `run` in a study of several robots)",
+                             hint="choose another output directory with -o")
+        return tuple(header)
+
+    def _runs(self, reader: _csv.Reader, text: str, data: bytes) -> list[dict]:
+        """The rows after the header, a run's robots' rows (written before the run's own) under
+        its ``robots``; each row's line in :attr:`_at`. The robots' rows of a run whose own
+        row is not there (killed as they were written) are left out, to be cut off."""
+        lines, rows, self._at = text.splitlines(), [], []
+        robots: list[tuple[dict, tuple[int, str, list[str]]]] = []   # before their run's
+        ended = reader.line_num                        # the line the last run's rows end on
+        for values in reader:
+            line_no = reader.line_num                  # (a row's last line)
+            at = (line_no, lines[line_no - 1], values)
+            row = self._row(*at)
+            name = row.pop("robot", "")
+            if robots and key_of(robots[0][0]) != key_of(row):
+                self._orphans(robots)
+            if name:
+                self._robot_once(robots, row, name, at)
+                robots.append(({**row, "robot": name}, at))
+                continue
+            if robots:
+                row["robots"] = self._robots_of(row, at, robots)
+                robots = []
+            rows.append(row)
+            self._at.append(at)
+            ended = line_no
+        if robots:       # a run's robots without the run's own row: killed as they were
+            self._keep, self._unended = _line_end(data, ended), False      # written
+        return rows
 
     def _row(self, line_no: int, line: str, values: list[str]) -> dict:
         """Line ``line_no``'s ``values`` as a row, checked: what a run (or a robot of it) can
@@ -428,43 +447,7 @@ class ResultStore:
         Everything is checked before anything is written: a refused study leaves the directory
         as it was.
         """
-        try:                  # a directory this user cannot enter: a traceback here
-            there = self.dir.exists()
-            previous = self.manifest_path.exists() or self.path.exists()
-        except OSError as exc:
-            raise StudyError(f"cannot use the output directory {self.dir}: "
-                             f"{exc.strerror or exc}",
-                             hint="choose a directory you can write to with -o") from None
-        if there and not self.dir.is_dir():
-            raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
-                             hint="choose a directory with -o (a new one is made)")
-        if resume and not previous:
-            # a mistyped -o began a new study under the name, and "0 from before" was all
-            # that said the study meant was not resumed
-            raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
-                             f"results.csv)", hint="check the directory given with -o, or "
-                             "leave out --resume to start a study there")
-        parent = self.dir.parent
-        if not there and not parent.is_dir():
-            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
-            # `mkdir -p notes.txt` were no help
-            found = file_in_the_way(parent)
-            if found is not None:
-                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
-                                 f"is a file, not a directory",
-                                 hint="choose another directory with -o")
-            # the directory alone is made, as every other writer makes only its file: a
-            # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
-            raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
-                             f"does not exist",
-                             hint=f"create it first (`mkdir -p {shlex.quote(str(parent))}`), "
-                                  f"or choose "
-                                  f"another directory with -o (compare makes the last one)")
-        try:
-            self.dir.mkdir(exist_ok=True)
-        except OSError as exc:
-            raise StudyError(f"cannot create the output directory {self.dir}: "
-                             f"{exc.strerror or exc}") from None
+        self._open_dir(resume)
         self._hold()
         _refuse_special(self.manifest_path, "study manifest")   # (written to below)
         rows = loaded = self.load()
@@ -502,6 +485,48 @@ class ResultStore:
         # kept open across append() calls (one fsync'd line per finished run); close() closes it
         self._file = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115
         return finished, todo
+
+    def _open_dir(self, resume: bool) -> None:
+        """The study's directory made (only it: a mistyped parent is refused, not made) or
+        found, refused with what to do when it cannot hold the study: not there to resume,
+        a file, out of this user's reach, or under a file."""
+        try:                  # a directory this user cannot enter: a traceback here
+            there = self.dir.exists()
+            previous = self.manifest_path.exists() or self.path.exists()
+        except OSError as exc:
+            raise StudyError(f"cannot use the output directory {self.dir}: "
+                             f"{exc.strerror or exc}",
+                             hint="choose a directory you can write to with -o") from None
+        if there and not self.dir.is_dir():
+            raise StudyError(f"`{self.dir}` is a file, not a directory for the study's results",
+                             hint="choose a directory with -o (a new one is made)")
+        if resume and not previous:
+            # a mistyped -o began a new study under the name, and "0 from before" was all
+            # that said the study meant was not resumed
+            raise StudyError(f"`{self.dir}` holds no study to resume (no study.json or "
+                             f"results.csv)", hint="check the directory given with -o, or "
+                             "leave out --resume to start a study there")
+        parent = self.dir.parent
+        if not there and not parent.is_dir():
+            # a file in the way (`-o notes.txt/study`): "`notes.txt` does not exist" and
+            # `mkdir -p notes.txt` were no help
+            found = file_in_the_way(parent)
+            if found is not None:
+                raise StudyError(f"cannot create the output directory `{self.dir}`: `{found}` "
+                                 f"is a file, not a directory",
+                                 hint="choose another directory with -o")
+            # the directory alone is made, as every other writer makes only its file: a
+            # mistyped parent (`-o studeis/norms`) made a tree of directories without a word
+            raise StudyError(f"cannot create the output directory `{self.dir}`: `{parent}` "
+                             f"does not exist",
+                             hint=f"create it first (`mkdir -p {shlex.quote(str(parent))}`), "
+                                  f"or choose "
+                                  f"another directory with -o (compare makes the last one)")
+        try:
+            self.dir.mkdir(exist_ok=True)
+        except OSError as exc:
+            raise StudyError(f"cannot create the output directory {self.dir}: "
+                             f"{exc.strerror or exc}") from None
 
     def _check_robots(self, rows: list[dict], robots: dict[str, tuple[str, ...]],
                       widen: bool) -> None:

@@ -651,7 +651,6 @@ FIRST_WORDS_HINT = ("a line is a rule (`if ... then ...`) or a command: " + ", "
 
 def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError:
     """Lark's exception in words: never ``$END`` or ``Token(...)``."""
-    lines = lines_of(text) or [""]
     if isinstance(exc, UnexpectedCharacters):
         pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
         char = text[pos] if pos < len(text) else ""
@@ -663,21 +662,39 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
     expected = set(getattr(exc, "expected", None) or ())
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
-        line = len(lines_of(text.rstrip())) or 1
-        column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
-        if text.split()[:1] == ["at"] and "to" in text.split()[2:3]:   # LALR's merged states:
-            expected = {e for e in expected if e.upper() != "TO"}     # the `to` is behind us
-        if text.split()[:1] == ["simulate"] and text.split()[-1] == "robot":
-            expected = {"NAME"}             # (a quoted one is said by the hint)
-        return RuleSyntaxError("the line ends too early",
-                               span=Span.in_text(text, path, line, column),
-                               expected=_expected(expected), hint=_eof_hint(text))
+        return _end_error(text, path, expected)
     assert isinstance(exc, UnexpectedToken)      # the third kind, after the two above
     token: Token = exc.token
     assert token.line is not None and token.column is not None   # the lexer places its tokens
     span = Span.in_text(text, path, token.line, token.column,
                         token.column + max(1, len(str(token.value))))
     before = text[:token.start_pos].split() if token.start_pos is not None else []
+    expected = _merged_states(before, expected)
+    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
+                           expected=_expected(expected),
+                           hint=_token_hint(text, token, before, expected))
+
+
+def _end_error(text: str, path: str, expected: set[str]) -> RuleSyntaxError:
+    """The line ended before its command or rule did, said at its end, with what may follow
+    there (less what LALR's merged states offer that cannot)."""
+    lines = lines_of(text) or [""]
+    line = len(lines_of(text.rstrip())) or 1
+    column = len(lines[line - 1]) + 1 if line <= len(lines) else 1
+    if text.split()[:1] == ["at"] and "to" in text.split()[2:3]:   # LALR's merged states:
+        expected = {e for e in expected if e.upper() != "TO"}     # the `to` is behind us
+    if text.split()[:1] == ["simulate"] and text.split()[-1] == "robot":
+        expected = {"NAME"}             # (a quoted one is said by the hint)
+    return RuleSyntaxError("the line ends too early",
+                           span=Span.in_text(text, path, line, column),
+                           expected=_expected(expected), hint=_eof_hint(text))
+
+
+def _merged_states(before: list[str], expected: set[str]) -> set[str]:
+    """What may stand after the words ``before``, of what the parser ``expected``: LALR
+    merges states the commands share, so it offers options of other commands (an `adapt`
+    option after `simulate`), an arrow already behind us, or too few (after `save FILE` the
+    line may only end)."""
     if before[:1] == ["save"]:              # `save out dir.rules`: one file name, then the end
         expected = {"$END"}
     if before[:1] == ["adapt"] and before[-1:] not in (["epochs"], ["rate"], ["plot"]):
@@ -695,30 +712,33 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
         # a target reuses the rule language's consequent, which a rule's `with` may follow;
         # a target takes no weight, and the line may end after it
         expected = expected - {"WITH"} | {"$END"}
-    hint = _teach_hint(text, token, before) or glued_name_hint(text, token) \
-        if str(token.value) != ";" else None
+    return expected
+
+
+def _token_hint(text: str, token: Token, before: list[str], expected: set[str]) -> str | None:
+    """What an unexpected ``token`` after the words ``before`` most likely means: a slip the
+    prompt knows (:func:`_teach_hint`, a glued name), FCL's `;`, `=` for `is`, a misspelt
+    keyword, or what a line begins with."""
+    if str(token.value) == ";":          # FCL's `... then speed is SLOW;` (not a hedge)
+        return "a rule or command needs no `;` at its end"
+    hint = _teach_hint(text, token, before) or glued_name_hint(text, token)
     if hint is not None:
-        pass
-    elif str(token.value) == ";":          # FCL's `... then speed is SLOW;` (not a hedge)
-        hint = "a rule or command needs no `;` at its end"
-    elif not before:
-        hint = FIRST_WORDS_HINT
-    elif str(token.value) == "=" and "IS" in expected and before and "->" not in before \
+        return hint
+    if not before:
+        return FIRST_WORDS_HINT
+    if str(token.value) == "=" and "IS" in expected and before and "->" not in before \
             and before[:1] != ["at"]:
         # `if road = WIDE then ...`: as in a rule file (`mitos_cli.lang.parse`)
-        hint = f"write `{before[-1]} is ...`: a condition or action reads `variable is " \
+        return f"write `{before[-1]} is ...`: a condition or action reads `variable is " \
                f"TERM` (or `is 5` for a crisp value), not `=`"
-    elif token.type == "NAME" and "IS" in expected and "->" in before:
-        hint = _target_hint(before)
-    elif token.type == "NAME" and "IS" in expected:
-        hint = "a condition reads `variable is TERM`"
-    elif "EQUAL" in expected:
-        hint = "give values as NAME=VALUE, e.g. `road=78`"
-    else:
-        hint = keyword_hint(token, expected) or (
-            joined_hint(text, token) if "if" in before and "->" not in before else None)
-    return RuleSyntaxError(f"unexpected {_describe(token)}", span=span,
-                           expected=_expected(expected), hint=hint)
+    if token.type == "NAME" and "IS" in expected and "->" in before:
+        return _target_hint(before)
+    if token.type == "NAME" and "IS" in expected:
+        return "a condition reads `variable is TERM`"
+    if "EQUAL" in expected:
+        return "give values as NAME=VALUE, e.g. `road=78`"
+    return keyword_hint(token, expected) or (
+        joined_hint(text, token) if "if" in before and "->" not in before else None)
 
 
 def _target_hint(before: list[str]) -> str:

@@ -24,7 +24,9 @@ from .session import Session
 from .text import quoted_column
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
     from types import ModuleType
+    from typing import TextIO
 
 
 class Completer:
@@ -231,7 +233,6 @@ def interact(session: Session, history: Path | None = None) -> None:
     tty = sys.stdin.isatty()
     readline = _setup_readline(session, history) if tty else None
     err = sys.stderr
-    lines_read = 0
     # a byte the input's encoding cannot read is the line's mistake, said at its place: read
     # strictly (`PYTHONIOENCODING=utf-8`) it was a traceback, the lines read with it lost
     with contextlib.suppress(AttributeError, ValueError, OSError):   # (not a text file)
@@ -239,28 +240,7 @@ def interact(session: Session, history: Path | None = None) -> None:
     session.out("MITOS teaching prompt: tell rules, correct, adapt, save. `help` lists the "
                 "commands; Ctrl-D or `quit` leaves (nothing is lost).")
     try:
-        while True:
-            ended = False                        # the input ended inside a wrapped rule
-            try:
-                line = input(prompt_text(session) if tty else "")
-                lines_read += 1
-                lineno = lines_read
-                while incomplete(line):          # a rule continued on the next line
-                    try:
-                        more = input("... " if tty else "")
-                    except EOFError:             # the rule is said cut short, not dropped
-                        ended = True
-                        break
-                    lines_read += 1
-                    if not more.strip():         # an empty line ends it (and says why)
-                        break
-                    line += "\n" + more
-            except EOFError:
-                session.out("")
-                break
-            except KeyboardInterrupt:
-                print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
-                continue
+        for line, lineno, ended in _statements(session, tty, err):
             if lineno == 1:                      # a file piped in, written with a BOM
                 line = line.removeprefix("\ufeff")
             if not line.strip() or line.lstrip().startswith("#"):
@@ -285,12 +265,48 @@ def interact(session: Session, history: Path | None = None) -> None:
                 session.out("")
                 break
     finally:
-        from .journal import resume_command
+        _farewell(session, err)
 
-        resume = resume_command(session.journal.directory)
-        if session.state.block is not None:
-            print(f"behavior `{session.state.block}` is still open; `{resume}` keeps it open, "
-                  f"`end` closes it", file=err)
-        if session.unsaved:
-            print(f"unsaved changes are kept in the journal; `{resume}` continues, `save PATH` "
-                  f"writes them", file=err)
+
+def _statements(session: Session, tty: bool, err: TextIO) -> Iterator[tuple[str, int, bool]]:
+    """Each statement read, a rule wrapped over lines joined into one, with the number of
+    its first line and whether the input ended inside it (the rule is then said cut short,
+    not dropped); until the input ends. Ctrl-C at the prompt drops the line and reads on."""
+    lines_read = 0
+    while True:
+        ended = False                        # the input ended inside a wrapped rule
+        try:
+            line = input(prompt_text(session) if tty else "")
+            lines_read += 1
+            lineno = lines_read
+            while incomplete(line):          # a rule continued on the next line
+                try:
+                    more = input("... " if tty else "")
+                except EOFError:             # the rule is said cut short, not dropped
+                    ended = True
+                    break
+                lines_read += 1
+                if not more.strip():         # an empty line ends it (and says why)
+                    break
+                line += "\n" + more
+        except EOFError:
+            session.out("")
+            return
+        except KeyboardInterrupt:
+            print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
+            continue
+        yield line, lineno, ended
+
+
+def _farewell(session: Session, err: TextIO) -> None:
+    """On leaving, what is left undone and the command that takes it up again (nothing is
+    lost: the journal holds it)."""
+    from .journal import resume_command
+
+    resume = resume_command(session.journal.directory)
+    if session.state.block is not None:
+        print(f"behavior `{session.state.block}` is still open; `{resume}` keeps it open, "
+              f"`end` closes it", file=err)
+    if session.unsaved:
+        print(f"unsaved changes are kept in the journal; `{resume}` continues, `save PATH` "
+              f"writes them", file=err)

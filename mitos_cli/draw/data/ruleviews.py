@@ -18,6 +18,7 @@ from .curves import compiled_of, curve_grid
 
 if TYPE_CHECKING:
     from ...api import LoadedRuleBase
+    from ...engine.evaluation import Result
 
 
 @dataclass(frozen=True)
@@ -165,7 +166,7 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
     carries the rule's implied output set and each output the aggregated set
     (:mod:`mitos_cli.engine.mamdani`). ``compiled`` may be what ``load_rulebase`` returns.
     """
-    from ...engine.evaluation import as_batch, declares_nan, evaluate
+    from ...engine.evaluation import as_batch, evaluate
 
     compiled = compiled_of(compiled, "rule_view")
 
@@ -174,19 +175,9 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
         raise InputError("the rule viewer takes one value per input")
     res = evaluate(compiled, X, detail=True, keep_values=True, strict=False)
     assert res.values is not None and res.memberships is not None and res.dof is not None
-    antecedent = res.values[0][compiled.rule_col]
     mu = res.memberships[0]
     dof = res.dof[0]
     term_index = {key: i for i, key in enumerate(compiled.term_names)}
-
-    inputs = []
-    for k, name in enumerate(compiled.inputs):
-        var = compiled.variables[name]
-        lo, hi = compiled.universe[k]
-        v = float(res.inputs[0, k])
-        mus = tuple((t.name, float(mu[term_index[(name, t.name)]])) for t in var.terms)
-        inputs.append(InputValue(name, var.unit, v, bool(res.clamped[k]) and v in (lo, hi), mus,
-                                 (float(lo), float(hi))))
 
     crisp = compiled.cons_value
     if compiled.cons_linear is not None:
@@ -198,9 +189,42 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
     if compiled.operators.inference == "tsukamoto":
         crisp = _tsukamoto_points(compiled, dof, crisp)
 
-    fired = np.flatnonzero(dof > 0)
+    inputs = _input_values(compiled, res, mu, term_index)
+    rows = _rule_rows(compiled, res.values[0][compiled.rule_col], dof, mu, term_index, crisp,
+                      sets)
+    outputs = _output_views(compiled, res, dof, crisp, sets)
+    return RuleView(compiled.behavior, compiled.describe_operators(), compiled.n_rules,
+                    inputs, rows, outputs)
+
+
+#: Each output's Mamdani sets (:func:`_mamdani_sets`): each rule's implied set, and the
+#: aggregated set on its grid.
+_Sets = list[tuple[dict[int, tuple[np.ndarray, np.ndarray]], np.ndarray, np.ndarray]]
+
+
+def _input_values(compiled: CompiledRuleBase, res: Result, mu: np.ndarray,
+                  term_index: dict[tuple[str, str], int]) -> tuple[InputValue, ...]:
+    """Each input's value (said to be clamped only when it was moved onto an end of its
+    universe) and its terms' memberships (``mu``, at ``term_index``)."""
+    inputs = []
+    for k, name in enumerate(compiled.inputs):
+        var = compiled.variables[name]
+        lo, hi = compiled.universe[k]
+        v = float(res.inputs[0, k])
+        mus = tuple((t.name, float(mu[term_index[(name, t.name)]])) for t in var.terms)
+        inputs.append(InputValue(name, var.unit, v, bool(res.clamped[k]) and v in (lo, hi), mus,
+                                 (float(lo), float(hi))))
+    return tuple(inputs)
+
+
+def _rule_rows(compiled: CompiledRuleBase, antecedent: np.ndarray, dof: np.ndarray,
+               mu: np.ndarray, term_index: dict[tuple[str, str], int], crisp: np.ndarray,
+               sets: _Sets | None) -> tuple[RuleRow, ...]:
+    """A row for each rule that fires (DOF > 0), in rule-base order: its propositions'
+    memberships, its consequents (each with its implied set under Mamdani inference), its
+    DOF and its condition's value before the weight (``antecedent``)."""
     rows = []
-    for r in fired.tolist():
+    for r in np.flatnonzero(dof > 0).tolist():
         rule = compiled.rules[r]
         props = []
         for prop, inverted in props_of(rule.antecedent):
@@ -213,6 +237,14 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
             for j, out in enumerate(compiled.outputs) if compiled.cons_mask[r, j])
         rows.append(RuleRow(int(r), compiled.labels[r], compiled.rule_text(r), float(dof[r]),
                             tuple(props), cons, float(antecedent[r])))
+    return tuple(rows)
+
+
+def _output_views(compiled: CompiledRuleBase, res: Result, dof: np.ndarray,
+                  crisp: np.ndarray, sets: _Sets | None) -> tuple[OutputView, ...]:
+    """Each output's value and what made it: the aggregated set under Mamdani inference,
+    else a stem per value the firing rules set (:func:`_summed`); whether no rule set it."""
+    from ...engine.evaluation import declares_nan
 
     outputs = []
     for j, name in enumerate(compiled.outputs):
@@ -228,8 +260,7 @@ def rule_view(compiled: CompiledRuleBase | LoadedRuleBase, values: dict[str, flo
         outputs.append(OutputView(name, var.unit, tuple(var.universe),
                                   compiled.operators.inference, value, not setting.any(),
                                   stems, grid, agg, declares_nan(compiled, name)))
-    return RuleView(compiled.behavior, compiled.describe_operators(), compiled.n_rules,
-                    tuple(inputs), tuple(rows), tuple(outputs))
+    return tuple(outputs)
 
 
 def _tsukamoto_points(compiled: CompiledRuleBase, dof: np.ndarray,
@@ -281,8 +312,7 @@ def _summed(compiled: CompiledRuleBase, j: int, rules: np.ndarray, crisp: np.nda
     return tuple(sorted(summed.items()))
 
 
-def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray
-                  ) -> list[tuple[dict[int, tuple[np.ndarray, np.ndarray]], np.ndarray, np.ndarray]]:
+def _mamdani_sets(compiled: CompiledRuleBase, dof: np.ndarray) -> _Sets:
     """Per output ``j``: ``({rule: (implied set, consequent set)}, grid, aggregate)`` for one
     sample's DOFs,
     from the sampled consequent sets the engine uses (:mod:`mitos_cli.engine.mamdani`)."""
