@@ -82,8 +82,8 @@ def compare_command(
     plots: Annotated[bool, typer.Option(
         "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
     as_json: Annotated[bool, typer.Option(
-        "--json", help="Print one JSON object (the summaries and the ranking; schema in "
-                       "docs/study.md) instead of the tables.")] = False,
+        "--json", help="Print one JSON object (the summaries and the ranking; schema: "
+                       "`mitos docs study`) instead of the tables.")] = False,
 ) -> None:
     """Compare T-norms, S-norms, inference methods and planners over worlds and seeded runs.
 

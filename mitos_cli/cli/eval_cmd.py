@@ -424,9 +424,9 @@ def _no_rule_hint(output: str, declared: bool) -> str:
     """What writes the other rows: ``--on-no-rule default`` only where ``output`` declares a
     default (without one it is the choice that just failed)."""
     if declared:
-        return "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)"
+        return "--on-no-rule default, nan or skip writes the other rows (`mitos docs interop`)"
     return (f"`{output}` declares no default: declare one, or give --on-no-rule nan or skip "
-            "to write the other rows (docs/interop.md)")
+            "to write the other rows (`mitos docs interop`)")
 
 
 def _fired_rows(compiled: CompiledRuleBase, result: Result, rows: np.ndarray,
