@@ -45,7 +45,8 @@ def compare_command(
              "tsukamoto (monotonic consequent terms only). Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
         "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
-        help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
+        help="Planners to compare, comma-separated: fuzzy, potential_field, dwa "
+             "(`fuzzy,dwa`).")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
         "--runs", metavar="N", click_type=RUNS,
         help="Randomised runs per world and choice (a comparison needs many; `simulate` "
