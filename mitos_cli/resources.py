@@ -1,8 +1,8 @@
-"""Where the grammar, the packaged rule bases and the packaged worlds live.
+"""Where the grammar, the packaged rule bases, worlds and the documentation live.
 
 In a wheel they are package data under ``mitos_cli/_data/`` (read with ``importlib.resources``,
 so they work from a zip too); in a source checkout they are the top-level ``grammar/``,
-``rulebases/`` and ``worlds/`` directories next to the package.
+``rulebases/``, ``worlds/`` and ``docs/`` directories next to the package (and the README).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ DEFAULT_WORLD = "corridor.yaml"
 
 
 def data_dir(kind: str) -> Traversable:
-    """The ``grammar``, ``rulebases`` or ``worlds`` directory as a Traversable."""
+    """The ``grammar``, ``rulebases``, ``worlds`` or ``docs`` directory as a Traversable."""
     packaged = importlib.resources.files("mitos_cli") / "_data" / kind
     if packaged.is_dir():
         return packaged
@@ -33,7 +33,11 @@ def grammar_text(name: str = "mitos.lark") -> str:
 
 def packaged_path(kind: str, name: str) -> Path:
     """A packaged file as a real filesystem path (extracted when the package is zipped)."""
-    resource = data_dir(kind) / name
+    return real_path(data_dir(kind) / name)
+
+
+def real_path(resource: Traversable) -> Path:
+    """A packaged file or folder as a real filesystem path (extracted when zipped)."""
     if isinstance(resource, Path):
         return resource.resolve()
     stack = importlib.resources.as_file(resource)  # zip: extract to a temporary file
@@ -60,6 +64,23 @@ def resolve(kind: str, name: str | Path, suffix: str, base: Path | None = None) 
         if is_file(data_dir(kind) / filename):
             return packaged_path(kind, filename)
     return None
+
+
+def doc_pages() -> dict[str, Traversable]:
+    """The documentation's pages by the name ``mitos docs`` takes: each ``docs/NAME.md``,
+    the README as ``readme`` and the worlds' README as ``worlds``. A wheel carries them under
+    ``mitos_cli/_data/docs/`` (the README beside the pages); a checkout has them in place."""
+    docs = data_dir("docs")
+    pages: dict[str, Traversable] = {}
+    if docs.is_dir():
+        for entry in sorted(docs.iterdir(), key=lambda e: e.name):
+            if entry.name.endswith(".md") and entry.name != "README.md":
+                pages[entry.name.removesuffix(".md")] = entry
+    readme = docs / "README.md"
+    pages["readme"] = readme if is_file(readme) else \
+        importlib.resources.files("mitos_cli") / ".." / "README.md"
+    pages["worlds"] = data_dir("worlds") / "README.md"
+    return pages
 
 
 def packaged_place(directory: str, kind: str) -> bool:

@@ -157,6 +157,38 @@ def test_every_choice_an_option_lists_is_said_in_its_help():
     assert unsaid == []
 
 
+def test_an_option_whose_value_is_a_list_says_it_is_comma_separated():
+    """`compare --planner` said "Planners to compare: fuzzy, potential_field, dwa." and not
+    how to give several (`--planner fuzzy dwa` read `dwa` as a world): every option whose
+    value `compare` splits at commas (`split_list`) says "comma-separated"."""
+    import ast
+
+    from mitos_cli.cli import compare_cmd
+
+    tree = ast.parse(Path(compare_cmd.__file__).read_text(encoding="utf-8"))
+    split = {arg.id for node in ast.walk(tree) if isinstance(node, ast.Call)
+             and getattr(node.func, "id", None) == "split_list"
+             for arg in node.args if isinstance(arg, ast.Name)}
+    params = {p.name: p for p in commands()["compare"].params}
+    lists = split & set(params)
+    assert lists == {"and_", "or_", "inference", "planner"}
+    unsaid = [params[n].opts[0] for n in sorted(lists) if "comma-separated" not in params[n].help]
+    assert unsaid == []
+
+
+def test_simulate_given_compare_s_list_of_planners_names_compare(capsys):
+    """`simulate --planner fuzzy,dwa` was "unknown planner `fuzzy,dwa`", did you mean
+    `fuzzy`?": simulate drives with one, and compare takes the list."""
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "--planner", "fuzzy,DWA"])
+    err = " ".join(capsys.readouterr().err.replace("│", " ").split())
+    assert info.value.code == 2
+    assert ("Invalid value for --planner: simulate drives with one planner (--planner NAME); "
+            "`mitos compare --planner fuzzy,dwa` compares them") in err
+
+
 def test_an_option_mitos_list_names_says_it_takes_a_packaged_name():
     """`mitos list` heads its rule bases `(--rulebase NAME)` and its lessons `(mitos teach
     --lesson NAME)`, and both options take such a name, but their help said only `PATH`,

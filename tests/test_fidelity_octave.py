@@ -8,6 +8,8 @@ with the file's ``AggMethod`` before the weighted average (``aggregate_fis_outpu
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -188,3 +190,58 @@ def test_eval_says_what_octave_does_otherwise(tmp_path, capsys):
         main(["eval", str(summed), "temp=12", "--fidelity", "octave"])
     assert not info.value.code
     assert "--fidelity octave changes nothing here" in capsys.readouterr().err
+
+
+LAMP = Path(__file__).parent / "golden" / "eval_fidelity_octave_no_rule" / "lamp.fis"
+
+
+def _eval(capsys, *args: str) -> tuple[int, str, str]:
+    from mitos_cli.cli.app import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["eval", *args])
+    out, err = capsys.readouterr()
+    return int(info.value.code or 0), out, err
+
+
+def test_where_no_rule_fires_octave_gives_nan_and_the_batch_says_so(tmp_path, capsys):
+    """Octave's ``evalfis`` on ``lamp.fis`` (0.4.6, ``printf ('%.17g')``): NaN at daylight 0,
+    5 and 10, where no rule fires, 76.386346586646653 at 3; MATLAB gives the middle of the
+    range (50), which ``--fidelity matlab`` keeps."""
+    batch = tmp_path / "in.csv"
+    batch.write_text("daylight\n0\n3\n10\n")
+    code, out, err = _eval(capsys, str(LAMP), "--batch", str(batch), "--fidelity", "octave")
+    assert code == 0
+    assert out.splitlines()[1:] == ["0,nan", "3,76.38634658664667", "10,nan"]
+    assert err == ("warning: no rule sets `power` in 2 rows of 3: Octave gives NaN there, and "
+                   "nan is written\n")
+    code, out, err = _eval(capsys, str(LAMP), "--batch", str(batch), "--fidelity", "matlab")
+    assert out.splitlines()[1:] == ["0,50.0", "3,76.38634658664667", "10,50.0"]
+    assert "the file's default (50) is written there" in err
+    # an --on-no-rule given still chooses
+    code, out, err = _eval(capsys, str(LAMP), "--batch", str(batch), "--fidelity", "octave",
+                           "--on-no-rule", "skip")
+    assert out.splitlines() == ["daylight,power,no_rule", "3,76.38634658664667,"]
+    code, out, err = _eval(capsys, str(LAMP), "--batch", str(batch), "--fidelity", "octave",
+                           "--on-no-rule", "error")
+    assert code == 1 and "no rule sets `power` for daylight=0 (row 1; 2 of 3 rows)" in err
+
+
+def test_a_sugeno_output_no_rule_sets_is_where_octave_stops(tmp_path, capsys):
+    """Octave's ``evalfis`` stops with an error on a Sugeno system where no rule fires
+    (``defuzzify_output_sugeno``: "next_agg_output(1,_): out of bound 0"); the fidelity gives NaN and
+    says so. A fuzzylite ``Default=`` line, which Octave does not read, stays the file's."""
+    sugeno = (LAMP.read_text().replace("'mamdani'", "'sugeno'")
+              .replace("DefuzzMethod='centroid'", "DefuzzMethod='wtaver'")
+              .replace("'trimf',[50 80 100]", "'constant',[80]")
+              .replace("'trimf',[0 20 50]", "'constant',[20]"))
+    path = tmp_path / "lamp_sugeno.fis"
+    path.write_text(sugeno)
+    code, out, err = _eval(capsys, str(path), "daylight=0", "--fidelity", "octave")
+    assert code == 0
+    assert out.splitlines()[-1] == ("  power = nan   (no rule sets it here; Octave's evalfis "
+                                    "stops with an error)")
+    written = tmp_path / "written.fis"
+    written.write_text(sugeno.replace("Range=[0 100]\n", "Range=[0 100]\nDefault=30\n"))
+    code, out, err = _eval(capsys, str(written), "daylight=0", "--fidelity", "octave")
+    assert out.splitlines()[-1] == "  power = 30.0   (its default: no rule sets it here)"

@@ -283,7 +283,7 @@ def test_a_grid_squeeze_hint_says_what_the_body_keeps(tmp_path):
     assert info.value.hint == ("widen the passage, or allow the squeeze with `route: "
                                "{min_clearance: 9.5}` (its body then keeps as little as 0.5 in "
                                "from the walls, closer than the brake can promise: "
-                               "worlds/README.md)")
+                               "`mitos docs worlds`)")
 
 
 def test_a_grid_door_the_body_cannot_pass_is_offered_no_squeeze(tmp_path):

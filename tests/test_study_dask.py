@@ -81,11 +81,13 @@ def test_an_unreachable_scheduler_leaves_the_directory_as_it_was(tmp_path, monke
     assert not (tmp_path / "s").exists()
 
 
-@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
 def test_a_plain_local_cluster_runs_a_strangers_code():
     """The attack on the cluster the Dask executor used to start: any local process that
     finds the port connects and runs code."""
-    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as plain, \
+    from mitos_cli.study.executors import QUIET_HTTP
+
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None,
+                                  scheduler_kwargs=QUIET_HTTP) as plain, \
             distributed.Client(plain.scheduler_address, timeout="5s") as stranger:
         assert stranger.run_on_scheduler(os.getpid) == os.getpid()
 
@@ -120,6 +122,34 @@ def test_a_stranger_cannot_reach_the_local_cluster(client):
         assert scratch.name.startswith("mitos-dask-") and scratch.stat().st_mode & 0o077 == 0
     # the owner's client still works, and its results are the serial run's (tests above)
     assert client.submit(sum, [1, 2]).result() == 3
+
+
+def test_the_local_cluster_binds_no_dashboard_port():
+    """`dashboard_address=None` still bound the scheduler's HTTP server to 8787: two studies
+    at once (`pytest -n 2`'s two workers) collided, the second warning "Port 8787 is already
+    in use". With 8787 taken, the cluster starts without a word, its HTTP server on
+    127.0.0.1 at a port of the system's choosing and no dashboard."""
+    import warnings
+
+    from mitos_cli.study.executors import local_cluster
+
+    taken = socket.socket()
+    try:
+        taken.bind(("127.0.0.1", 8787))
+        taken.listen()
+    except OSError:
+        pass                                  # taken already: the case to test all the same
+    try:
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            with local_cluster(1) as cluster:
+                http = cluster.scheduler.http_server
+                assert (http.address, cluster.scheduler.services["dashboard"]) == \
+                    ("127.0.0.1", http)
+                assert http.port not in (0, 8787)
+        assert [str(w.message) for w in said if "already in use" in str(w.message)] == []
+    finally:
+        taken.close()
 
 
 def test_a_local_cluster_has_no_more_workers_than_tasks(monkeypatch, tmp_path):

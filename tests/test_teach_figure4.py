@@ -87,6 +87,10 @@ def test_what_was_learned_is_linguistic(taught):
         'terms "mitos.terms.yaml", "drive.terms.yaml"']    # rules untouched: terms moved
     drive_terms = (path.parent / "taught.drive.terms.yaml").read_text(encoding="utf-8")
     assert "AHEAD" in drive_terms
+    # the width the paper's eq. 15 gives moved: its comment says it was so before teaching
+    terms = (path.parent / "taught.mitos.terms.yaml").read_text(encoding="utf-8")
+    assert "MEDIUM: {shape: triangle, peak: 70, width: 17.71}       # eq. 15: width 30 in " \
+        "(before teaching)\n" in terms
 
 
 def test_the_lesson_is_in_words_and_the_taught_rule_base_keeps_its_meaning(taught):

@@ -79,7 +79,10 @@ def test_changed_numbers_only(rules, tmp_path):
     after = [held.sub(r"\1", line) for line in after]
     assert len(before) == len(after)
     for a, b in zip(before, after):
-        if a != b:      # same line, same keys and comments: only numbers differ
+        # same line, same keys and comments: only numbers differ, and a comment beside a
+        # number that changed is marked as said before teaching
+        b = b.removesuffix(" (before teaching)")
+        if a != b:
             assert [w for w in a.replace(",", " ").split() if not _number(w)] == \
                    [w for w in b.replace(",", " ").split() if not _number(w)]
     assert "# eq. 15: width 30 in" in "\n".join(after)
@@ -115,7 +118,7 @@ def test_crisp_consequents_are_edited_in_place(tmp_path):
     s.run(f"save {tmp_path / 'u.rules'}")
     text = (tmp_path / "u.rules").read_text()
     assert text.startswith('terms "u.terms.yaml"\n# comment\nr1: if x is LO\n   then y is ')
-    assert "   # low\n" in text
+    assert "   # low (before teaching)\n" in text        # it spoke of 20, learned away
     r1, r2 = load_rules_file(tmp_path / "u.rules").behaviors[0].rules
     assert abs(r1.consequents[0].value - 30) < 1 and abs(r2.consequents[0].value - 70) < 1
 
@@ -137,7 +140,7 @@ def test_unlabelled_rules_are_saved_in_their_places(tmp_path):
     s.run(f"save {tmp_path / 'u.rules'}")
     text = (tmp_path / "u.rules").read_text()
     assert text.count("if x is LO") == 1 and text.count("if x is HI") == 2
-    assert "   # low\n" in text
+    assert "   # low (before teaching)\n" in text        # it spoke of 20, learned away
     r1, r2, r3 = load_rules_file(tmp_path / "u.rules").behaviors[0].rules
     assert abs(r1.consequents[0].value - 30) < 1 and abs(r2.consequents[0].value - 70) < 1
     assert r3.consequents[0].value == 90
@@ -897,3 +900,66 @@ def test_save_refuses_a_link_into_another_directory(tmp_path):
     (tmp_path / "same.rules").symlink_to("kept2.rules")
     s.run(f"save {tmp_path / 'same.rules'}")
     assert load_rules_file(tmp_path / "kept2.rules").termset_paths == ("same.terms.yaml",)
+
+
+def test_a_comment_on_a_number_that_changed_is_marked_and_the_rest_kept():
+    """The shipped lesson's save kept `# eq. 15: width 30 in` beside `width: 17.71`, which it
+    no longer is: a comment on the line of a number the save changes says it was so before
+    teaching; a comment on an unchanged line, a `#` inside quotes and a header stay."""
+    import dataclasses
+
+    from mitos_cli.lang.termfile import parse_termset
+    from mitos_cli.teach.save import edit_termset
+
+    text = ("# the term set, as drawn   # (a header: kept)\n"
+            "variables:\n  x:\n    description: \"x # not a comment\"\n    role: input\n"
+            "    universe: [0, 100]\n    terms:\n"
+            "      LOW:  {shape: left_shoulder, points: [20, 50]}   # eq. 3: 20 in\n"
+            "      MID:\n        shape: triangle\n        peak: 50      # the centre\n"
+            "        width: 30     # eq. 4: width 30\n"
+            "      HIGH: {shape: right_shoulder, points: [50, 80]}  # at 80 (before teaching)\n"
+            "      TOP:  {shape: right_shoulder, points: [80, 95]}  # untouched\n")
+    old = parse_termset(text, "x.yaml")
+    moved = {"LOW": (25.5, 50.0), "MID": (50.0, 24.5), "HIGH": (50.0, 75.0),
+             "TOP": (80.0, 95.0)}
+    new = dataclasses.replace(old, variables=tuple(v.with_terms(tuple(
+        dataclasses.replace(t, params=moved[t.name]) for t in v.terms))
+        for v in old.variables))
+    written, changes = edit_termset(text, "x.yaml", old, new)
+    assert written == (text
+                       .replace("[20, 50]}   # eq. 3: 20 in",
+                                "[25.5, 50]}   # eq. 3: 20 in (before teaching)")
+                       .replace("width: 30     # eq. 4: width 30",
+                                "width: 24.5     # eq. 4: width 30 (before teaching)")
+                       .replace("[50, 80]}  # at 80 (before teaching)",
+                                "[50, 75]}  # at 80 (before teaching)"))
+    assert changes == ["x.LOW: (20, 50) -> (25.5, 50); its comment marked `(before teaching)`",
+                       "x.MID: (50, 30) -> (50, 24.5); its comment marked `(before teaching)`",
+                       "x.HIGH: (50, 80) -> (50, 75)"]
+    assert parse_termset(written).variables[0] == new.variables[0]
+
+
+def test_a_comment_beside_a_learned_crisp_value_is_marked(tmp_path):
+    """The same in a rule file: adaptation moves a crisp consequent (`then y is 10`), and the
+    comment on its line spoke of 10; a rule's comment on a line that kept its numbers stays."""
+    (tmp_path / "r.terms.yaml").write_text(
+        "variables:\n  x:\n    role: input\n    universe: [0, 10]\n    terms:\n"
+        "      LOW: {shape: left_shoulder, points: [2, 8]}\n"
+        "      HIGH: {shape: right_shoulder, points: [2, 8]}\n"
+        "  y:\n    role: output\n    universe: [0, 100]\n    terms: {A: 0}\n")
+    (tmp_path / "r.rules").write_text(
+        'terms "r.terms.yaml"\n'
+        "r1: if x is LOW then y is 10     # ten, as measured\n"
+        "r2: if x is HIGH then y is 90    # ninety\n")
+    s = Session(tmp_path / "r.rules", out=[].append)
+    s.run("frozen x.LOW, x.HIGH")
+    s.run("frozen r2")
+    s.run("correct x=0 -> y=30")
+    s.run("adapt epochs 20")
+    s.run(f"save {tmp_path / 'out.rules'}")
+    text = (tmp_path / "out.rules").read_text()
+    learned = s.rulebase.behaviors[0].rules[0].consequents[0].value
+    assert learned is not None and learned > 10
+    assert text.splitlines()[1:3] == [
+        f"r1: if x is LOW then y is {learned:.4g}     # ten, as measured (before teaching)",
+        "r2: if x is HIGH then y is 90    # ninety"]

@@ -37,6 +37,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "simulate": ("simulate_cmd", "simulate_command"),
     "plot": ("plot_cmd", "plot_app"),
     "list": ("list_cmd", "list_command"),
+    "docs": ("docs_cmd", "docs_command"),
 }
 
 

@@ -45,7 +45,8 @@ def compare_command(
              "tsukamoto (monotonic consequent terms only). Default: the rule base's.")] = None,
     planner: Annotated[str, typer.Option(
         "--planner", metavar="PLANNERS", autocompletion=complete.planner_list,
-        help="Planners to compare: fuzzy, potential_field, dwa.")] = "fuzzy,potential_field",
+        help="Planners to compare, comma-separated: fuzzy, potential_field, dwa "
+             "(`fuzzy,dwa`).")] = "fuzzy,potential_field",
     runs: Annotated[int, typer.Option(
         "--runs", metavar="N", click_type=RUNS,
         help="Randomised runs per world and choice (a comparison needs many; `simulate` "
@@ -82,8 +83,8 @@ def compare_command(
     plots: Annotated[bool, typer.Option(
         "--plots/--no-plots", help="Draw the plots of report.md (needs matplotlib).")] = True,
     as_json: Annotated[bool, typer.Option(
-        "--json", help="Print one JSON object (the summaries and the ranking; schema in "
-                       "docs/study.md) instead of the tables.")] = False,
+        "--json", help="Print one JSON object (the summaries and the ranking; schema: "
+                       "`mitos docs study`) instead of the tables.")] = False,
 ) -> None:
     """Compare T-norms, S-norms, inference methods and planners over worlds and seeded runs.
 

@@ -1,6 +1,6 @@
 """Shell completion beyond options (``mitos --install-completion``): packaged world names,
-planners and executors. A word no packaged name starts with completes as a file, the shell's
-default."""
+planners, executors and the documentation's pages. A word no packaged name starts with
+completes as a file, the shell's default."""
 
 from __future__ import annotations
 
@@ -33,3 +33,10 @@ def executors(incomplete: str) -> list[str]:
     from ..study.executors import EXECUTORS
 
     return [n for n in EXECUTORS if n.startswith(incomplete)]
+
+
+def pages(incomplete: str) -> list[str]:
+    """``mitos docs`` pages by name (``interop``, ``readme``)."""
+    from ..resources import doc_pages
+
+    return [n for n in doc_pages() if n.startswith(incomplete)]

@@ -51,7 +51,7 @@ def convert_command(
         "--dialect", metavar=choices(Dialect), autocompletion=completer(Dialect),
         help="With --to fcl, the readers to write for: fuzzylite (fuzzylite 6, the default) "
              "or iec (IEC 61131-7 and jFuzzyLogic). They differ in where ACCU stands and "
-             "what joins two conclusions (docs/interop.md).")] = None,
+             "what joins two conclusions (`mitos docs interop`).")] = None,
 ) -> None:
     """Convert a rule base between the MITOS rule language, FCL, MATLAB .fis and fuzzylite FLL.
 

@@ -232,14 +232,15 @@ def eval_command(
              "it gives none, as in every FCL `METHOD : COG;` and .fis), both with an FCL or "
              ".fis file's inputs not clamped; octave (Octave's fuzzy-logic-toolkit on a .fis: "
              "101 points, the trapezoid rule, a Sugeno output's equal values joined by the "
-             "file's AggMethod).")] = None,
+             "file's AggMethod, and NaN, said as Octave's, where no rule sets an output and "
+             "MATLAB gives the middle of its range).")] = None,
 ) -> None:
     """Evaluate a rule base: fuzzified inputs, fired rules with DOFs, crisp outputs."""
     on_no_rule = (None if on_no_rule_name is None
                   else choice(NoRule, on_no_rule_name, "--on-no-rule policy"))
     fidelity = None if fidelity_name is None else choice(Engine, fidelity_name, "engine")
     path, values = split_args(args or [])
-    rb = _loaded(path, behavior, fidelity)
+    rb, engine_nan = _loaded(path, behavior, fidelity)
     if network:
         if batch is not None or values or as_json or digits is not None:
             raise typer.BadParameter("--network prints the rule base's network and evaluates "
@@ -255,7 +256,7 @@ def eval_command(
         if as_json:
             raise typer.BadParameter("--batch writes a CSV; --json is for one evaluation "
                                      "(leave one of them out)")
-        run_batch(rb, batch, on_no_rule, digits)
+        run_batch(rb, batch, on_no_rule, digits, engine_nan)
         return
     if on_no_rule is not None:
         raise typer.BadParameter("--on-no-rule applies to --batch")
@@ -266,12 +267,15 @@ def eval_command(
         raise typer.BadParameter("--json gives every digit (the shortest text that reads back "
                                  "as the same number); --digits rounds the trace and a "
                                  "--batch's outputs: leave one of them out")
-    _evaluate_one(rb, values, as_json, digits)
+    _evaluate_one(rb, values, as_json, digits, engine_nan)
 
 
-def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None) -> LoadedRuleBase:
+def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None
+            ) -> tuple[LoadedRuleBase, dict[str, str]]:
     """The rule base (the packaged one without ``path``), its notes said, read as the engine
-    ``fidelity`` names where one is asked for; a lone word that is no file is a lost ``=``."""
+    ``fidelity`` names where one is asked for, and the outputs for which that engine has no
+    number where no rule sets them (:func:`~mitos_cli.interop.common.engine_defaults`), each
+    with what it does; a lone word that is no file is a lost ``=``."""
     from ..api import LoadedRuleBase, load_rulebase
 
     if path is not None and not _names_file(path):  # `mitos eval road78 size=45`: a lost `=`
@@ -284,8 +288,8 @@ def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None) -> 
     rb = load_rulebase(path, behavior)
     warn_notes(rb.rulebase)
     if fidelity is None:
-        return rb
-    from ..interop.common import fidelity_rulebase, fidelity_settings
+        return rb, {}
+    from ..interop.common import engine_defaults, fidelity_rulebase, fidelity_settings
 
     settings = fidelity_settings(rb.rulebase, fidelity.value, behavior)
     ops = rb.compiled.operators
@@ -299,7 +303,8 @@ def _loaded(path: str | None, behavior: str | None, fidelity: Engine | None) -> 
     if fidelity.value == "octave" and ops.inference == "mamdani" and "bisector" in ops.defuzzify:
         warn("Octave's bisector gives the index of its sample, not the sample (defuzz.m): "
              "--fidelity octave gives the sample, by the trapezoid rule's areas")
-    return LoadedRuleBase(fidelity_rulebase(rb.rulebase, fidelity.value), behavior, settings)
+    return (LoadedRuleBase(fidelity_rulebase(rb.rulebase, fidelity.value), behavior, settings),
+            engine_defaults(rb.rulebase, fidelity.value))
 
 
 def _names_file(word: str) -> bool:
@@ -317,9 +322,13 @@ def _names_file(word: str) -> bool:
             or rule_file_hint(word) is not None)
 
 
-def _evaluate_one(rb: LoadedRuleBase, values: dict[str, str], as_json: bool, digits: int | None) -> None:
+def _evaluate_one(rb: LoadedRuleBase, values: dict[str, str], as_json: bool, digits: int | None,
+                  engine_nan: dict[str, str] | None = None) -> None:
     """One sample from its ``NAME=VALUE`` texts: its trace (or JSON), and warnings on stderr for
-    clamped inputs, outputs outside their universes and undersampled terms that fired."""
+    clamped inputs, outputs outside their universes and undersampled terms that fired; the
+    trace says what the engine does for the outputs of ``engine_nan`` that no rule sets."""
+    import dataclasses
+
     from ..engine.evaluation import as_batch, evaluate
     from ..engine.trace import trace_of
 
@@ -333,6 +342,9 @@ def _evaluate_one(rb: LoadedRuleBase, values: dict[str, str], as_json: bool, dig
     warn_outside(rb.compiled, result.outputs)
     warn_undersampled(rb, result.dof)
     trace = trace_of(result, given=X)
+    if engine_nan:
+        trace = dataclasses.replace(trace, engine_nan=tuple(
+            (name, engine_nan[name]) for name in trace.defaulted if name in engine_nan))
     if as_json:
         emit(json_text(trace.to_json(), infinity_as_text=True))
     else:
@@ -357,8 +369,9 @@ def unused_inputs(rb: LoadedRuleBase) -> tuple[str, ...]:
 
 
 def run_batch(rb: LoadedRuleBase, source: str, on_no_rule: NoRule | None = None,
-              digits: int | None = None) -> None:
-    """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV."""
+              digits: int | None = None, engine_nan: dict[str, str] | None = None) -> None:
+    """Read the CSV, evaluate all rows as one batch, write inputs and outputs as CSV;
+    ``engine_nan``: the outputs whose default is NaN for an engine (``--fidelity``)."""
     from ..engine.csvio import flag_name, passed_names, read_table, row_span, write_batch
     from ..engine.evaluation import rule_dofs
     from ..engine.mamdani import undersampled
@@ -390,7 +403,7 @@ def run_batch(rb: LoadedRuleBase, source: str, on_no_rule: NoRule | None = None,
     if undersampled(rb.compiled):       # the rules' DOFs, only when there is a term to tell
         warn_undersampled(rb, rule_dofs(rb.compiled, X))
     Y, keep, flags = no_rule_policy(rb.compiled, result, on_no_rule or NoRule.default,
-                                    lambda row: row_span(text, name, row))
+                                    lambda row: row_span(text, name, row), engine_nan)
     warn_outside(rb.compiled, Y[keep])
     flag = flag_name(rb.compiled.inputs, rb.compiled.outputs)
     taken = (*rb.compiled.inputs, *rb.compiled.outputs, *(() if on_no_rule is None
@@ -411,9 +424,9 @@ def _no_rule_hint(output: str, declared: bool) -> str:
     """What writes the other rows: ``--on-no-rule default`` only where ``output`` declares a
     default (without one it is the choice that just failed)."""
     if declared:
-        return "--on-no-rule default, nan or skip writes the other rows (docs/interop.md)"
+        return "--on-no-rule default, nan or skip writes the other rows (`mitos docs interop`)"
     return (f"`{output}` declares no default: declare one, or give --on-no-rule nan or skip "
-            "to write the other rows (docs/interop.md)")
+            "to write the other rows (`mitos docs interop`)")
 
 
 def _fired_rows(compiled: CompiledRuleBase, result: Result, rows: np.ndarray,
@@ -444,11 +457,14 @@ def _unset_words(out: str, count: int, fired: int, n: int) -> str:
 
 
 def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
-                   where: Callable[[int], Span | None] | None = None
+                   where: Callable[[int], Span | None] | None = None,
+                   engine_nan: dict[str, str] | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(outputs, rows to keep, no_rule column)`` after applying ``policy`` to the rows where
     no rule set an output; a warning says how many rows each output's choice changed. An
-    error stops at the first such row, at ``where(row)`` (its place in the batch file)."""
+    error stops at the first such row, at ``where(row)`` (its place in the batch file).
+    ``engine_nan`` names the outputs whose default is NaN for an engine (``--fidelity
+    octave``), each with what the engine does there, which the warning says."""
     import numpy as np
 
     from ..engine.evaluation import declares_nan
@@ -478,7 +494,9 @@ def no_rule_policy(compiled: CompiledRuleBase, result: Result, policy: NoRule,
                 span=None if where is None else where(row),
                 hint=_no_rule_hint(out, declared))
         what = _unset_words(out, count, int(fired.sum()), n)
-        if policy is NoRule.default:
+        if policy is NoRule.default and engine_nan and out in engine_nan:
+            warn(f"{what}: {engine_nan[out]} there, and nan is written")
+        elif policy is NoRule.default:
             warn(f"{what}: the file's default ({shown}) is written there")
         elif policy is NoRule.nan:
             Y[rows, j] = np.nan

@@ -60,6 +60,11 @@ EXAMPLES: dict[str, tuple[tuple[str, str], ...]] = {
         ("mitos list worlds", "the worlds alone"),
         ("mitos list --json", "as JSON"),
     ),
+    "docs": (
+        ("mitos docs", "the pages of the documentation, installed with MITOS"),
+        ("mitos docs interop", "a page, as Markdown"),
+        ("mitos docs teach --path", "where the page's file is"),
+    ),
     "plot terms": (
         ("mitos plot terms -b avoid_obstacle road=78 size=45 position=4", "in the terminal"),
         ("mitos plot terms --var road -o road.png", "one variable, as a PNG"),

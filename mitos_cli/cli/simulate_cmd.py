@@ -275,6 +275,11 @@ def simulate_command(
 
     require = _checked_require(require)
     planner_name = planner_name.lower()        # any case, as every option's fixed list
+    several = [p.strip() for p in planner_name.split(",")]
+    if len(several) > 1 and all(p in PLANNERS for p in several):   # compare's list, here
+        raise typer.BadParameter(f"simulate drives with one planner (--planner NAME); "
+                                 f"`mitos compare --planner {','.join(several)}` compares "
+                                 f"them", param_hint="--planner")
     with option_names():                        # an unknown name fails before any file is read
         planner_kind(planner_name)
     if plot is not None:                        # before the run, as `plot -o` does

@@ -78,7 +78,7 @@ def teach_command(
                           "journal.jsonl.damaged).")] = False,
     as_json: Annotated[bool, typer.Option(
         "--json", help="With --lesson: print one JSON object (each command and what it "
-                       "printed; schema in docs/teach.md) instead of the transcript.")] = False,
+                       "printed; schema: `mitos docs teach`) instead of the transcript.")] = False,
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
     from ..teach.prompt import interact

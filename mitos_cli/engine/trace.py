@@ -57,6 +57,9 @@ class Trace:
     #: of ``defaulted``, those whose rules fire but give them no value (a Mamdani set 0 at
     #: every sample, Tsukamoto inverses at +inf and -inf): their `default` applies too
     unvalued: tuple[str, ...] = ()
+    #: of ``defaulted``, those whose NaN there stands for what an engine does (``eval
+    #: --fidelity octave``: "Octave gives NaN" where MATLAB gives the middle of the range)
+    engine_nan: tuple[tuple[str, str], ...] = ()
 
     def __repr__(self) -> str:
         """A line: the behavior, the inputs as given, the outputs and how many rules fired
@@ -123,10 +126,13 @@ class Trace:
         if not self.rules:
             lines.append("  (none)")
         lines += ["", "outputs:"]
+        engines = dict(self.engine_nan)
         for name, value, unit in self.outputs:
+            why = ("the rules that fire give it no value here" if name in self.unvalued
+                   else "no rule sets it here")
             note = "" if name not in self.defaulted else \
-                "   (its default: the rules that fire give it no value here)" \
-                if name in self.unvalued else "   (its default: no rule sets it here)"
+                f"   ({why}; {engines[name]})" if name in engines else \
+                f"   (its default: {why})"
             lines.append(f"  {name} = {with_unit(num(value), unit)}".rstrip() + note)
         return "\n".join(lines)
 

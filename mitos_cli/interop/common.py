@@ -1088,16 +1088,40 @@ def _octave_accumulation(rb: RuleBase) -> tuple[Setting, ...]:
     return () if method == "sum" else (Setting("accumulation", method),)
 
 
+def engine_defaults(rb: RuleBase, engine: str) -> dict[str, str]:
+    """The outputs for which ``engine`` has no number where no rule sets them, though ``rb``'s
+    reading gives its default there, each with what the engine does, to be said beside the
+    NaN the fidelity gives instead. MATLAB returns the middle of the output's range, which
+    the ``.fis`` reader makes the default; Octave's toolkit (0.4.6) returns NaN for a Mamdani
+    output and stops with an error for a Sugeno one (``defuzzify_output_sugeno`` indexes an
+    empty aggregate). Octave reads no fuzzylite ``Default=`` line (``readfis`` stops there),
+    so a written default other than the middle stays the file's."""
+    if engine != "octave" or not (rb.path or "").lower().endswith(".fis"):
+        return {}
+    mamdani = ops_mod.of_behavior(rb, rb.behavior(None)).inference == "mamdani"
+    said = "Octave gives NaN" if mamdani else "Octave's evalfis stops with an error"
+    return {v.name: said for v in rb.variables.values()
+            if v.role == "output" and v.default == (v.universe[0] + v.universe[1]) / 2}
+
+
 def fidelity_rulebase(rb: RuleBase, engine: str) -> RuleBase:
     """``rb`` as ``engine`` samples its outputs: fuzzylite (8 and 6) gives each Mamdani output
     its defuzzifier's resolution, so the outputs' own ``resolution`` stays; MATLAB, Octave and
     jFuzzyLogic sample every output alike (:data:`FIDELITY`), so it goes, and the behavior's
-    (:func:`fidelity_settings`) is every output's."""
-    if FIDELITY.get(engine, (None,))[0] is None or not any(
-            v.resolution is not None for v in rb.variables.values()):
+    (:func:`fidelity_settings`) is every output's. The outputs of :func:`engine_defaults`
+    declare NaN, the engine's value where no rule sets them."""
+    nan = engine_defaults(rb, engine)
+    alike = FIDELITY.get(engine, (None,))[0] is not None and any(
+        v.resolution is not None for v in rb.variables.values())
+    if not nan and not alike:
         return rb
-    termsets = tuple(replace(ts, variables=tuple(replace(v, resolution=None)
-                                                 for v in ts.variables)) for ts in rb.termsets)
+
+    def as_engine(v: Variable) -> Variable:
+        return replace(v, resolution=None if alike else v.resolution,
+                       default=math.nan if v.name in nan else v.default)
+
+    termsets = tuple(replace(ts, variables=tuple(as_engine(v) for v in ts.variables))
+                     for ts in rb.termsets)
     return replace(rb, termsets=termsets)
 
 

@@ -146,7 +146,7 @@ class FuzzyPlanner:
                 + ", which the simulator does not perceive",
                 span=first_use(loaded.rulebase, self.compiled.behavior, missing[0]),
                 expected="inputs among " + ", ".join(INPUTS),
-                hint="the simulator measures only these (worlds/README.md, \"What the robot "
+                hint="the simulator measures only these (`mitos docs worlds`, \"What the robot "
                      "perceives\"); simulate a behavior that reads them (--behavior)")
         for out in ("steering", "speed"):
             if out not in self.compiled.outputs:

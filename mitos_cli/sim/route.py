@@ -594,7 +594,7 @@ def narrow_passage(x: float, y: float, gap: float, need: float, kind: str, wide:
     clearance less ``half_width``, not the centre's own."""
     squeeze = math.floor(gap * 10) / 10
     body = gap - half_width
-    brake = (", closer than the brake can promise: worlds/README.md" if body < BRAKE_PROMISE
+    brake = (", closer than the brake can promise: `mitos docs worlds`" if body < BRAKE_PROMISE
              else "")
     return NarrowPassage(
         f"the only way to the goal passes ({x:.0f}, {y:.0f}), where the robot's centre keeps "

@@ -581,7 +581,7 @@ def _not_a_map(doc: Any, span: Span) -> None:
                          f"not a world file", span=span,
                          expected="a world: `name`, `q_init`, `q_goal`, `map` and more",
                          hint=f"a world drives on it by naming it, `map: {{grid: {name}}}` "
-                              f"(worlds/README.md; `worlds/office.yaml` is one)")
+                              f"(`mitos docs worlds`; the packaged world `office` is one)")
 
 
 def parse_world(text: str, path: str) -> World:
@@ -1588,7 +1588,7 @@ def load_world(path: str | Path) -> World:
             doc = None
         if not (isinstance(doc, dict) and "map" in doc):
             raise WorldError(f"`{path}` is not a world file", span=Span(str(path), 1, 1),
-                             expected="a YAML file with `map:` (see worlds/README.md)")
+                             expected="a YAML file with `map:` (see `mitos docs worlds`)")
     return parse_world(text, str(path))
 
 

@@ -149,6 +149,14 @@ def dask_client(scheduler: str | None, workers: int, timeout: str = "10s") -> Cl
     return Client(cluster, security=cluster.security)
 
 
+#: The scheduler's HTTP server (its health and metrics routes: no dashboard is asked for) on
+#: 127.0.0.1 at a port the system picks. ``dashboard_address=None`` leaves the dashboard out
+#: but still binds that server to 8787 (``Scheduler.start_http_server``'s default), so two
+#: studies at once (or two test workers) collided, the second warning "Port 8787 is already
+#: in use" and taking another.
+QUIET_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
+
 def local_cluster(workers: int) -> LocalCluster:
     """A LocalCluster of ``workers`` processes that only this process and its workers can use.
 
@@ -184,6 +192,7 @@ def local_cluster(workers: int) -> LocalCluster:
         with interrupts_ignored_by_children():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None, host="127.0.0.1",
+                                   scheduler_kwargs=QUIET_HTTP,
                                    security=security, local_directory=scratch,
                                    silence_logs=logging.CRITICAL)
     except BaseException:

@@ -74,7 +74,7 @@ at 11s to 13s steering=55     one example per recorded tick from 11 s to 13 s
 at 11s to 13s steering is LM  the same, in words
 at 13s to 14.5s make a wider turn    an instruction: what the robot did, transformed; one of
     turn harder, turn less, make a wider turn, slow down, speed up,
-    keep further from the wall, keep right (docs/teach.md defines each)
+    keep further from the wall, keep right (`mitos docs teach` defines each)
 `at` corrects the behavior that drove the run (the rules that produced the motion), also when
 another behavior is active now: `use` it before `adapt`.""",
     "adapt": """\

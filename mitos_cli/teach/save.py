@@ -422,13 +422,45 @@ def _offsets(text: str) -> list[int]:
     return starts
 
 
+#: What a save adds to a comment on a line whose numbers it changed, so that the comment
+#: stays true: `MEDIUM: {shape: triangle, peak: 70, width: 17.71}  # eq. 15: width 30 in`
+#: said of the taught width what was true of the paper's.
+BEFORE_TEACHING = " (before teaching)"
+
+
+def _comment_after(text: str, at: int, yaml: bool = True) -> tuple[int, int] | None:
+    """The comment that ends the line of offset ``at``, after it (a ``#`` outside quotes, in
+    YAML after a blank): its start and its end, trailing blanks left out; ``None`` without
+    one."""
+    end = text.find("\n", at)
+    end = len(text) if end < 0 else end
+    quote = None
+    i = at
+    while i < end:
+        c = text[i]
+        if quote is not None:
+            if c == "\\" and quote == '"':
+                i += 1                          # an escaped character in double quotes
+            elif c == quote:
+                quote = None
+        elif c in "'\"":
+            quote = c
+        elif c == "#" and (not yaml or i == 0 or text[i - 1] in " \t"):
+            return i, len(text[:end].rstrip(" \t"))
+        i += 1
+    return None
+
+
 def edit_termset(text: str, path: str, old: TermSet, new: TermSet) -> tuple[str, list[str]]:
     """``text`` with the parameters of every term that differs between ``old`` and ``new``
-    (term sets of the same variables and terms) replaced in place."""
+    (term sets of the same variables and terms) replaced in place. A comment on the line of a
+    number that changed spoke of the number before: it is marked ``(before teaching)``
+    (:data:`BEFORE_TEACHING`); every other comment stays as it is."""
     data = yamlpos.load(text, path, TermSetError)
     starts = _offsets(text)
     edits: list[tuple[int, int, str]] = []
     changes: list[str] = []
+    marked: set[tuple[int, int]] = set()        # comments marked: one line, several terms
     variables = data["variables"]
     for v_old, v_new in zip(old.variables, new.variables):
         spec = variables[v_old.name]
@@ -449,12 +481,20 @@ def edit_termset(text: str, path: str, old: TermSet, new: TermSet) -> tuple[str,
                     "held at its point" if t_new.held_at is None else
                     f"`held: {now['held']}` written (its neighbours no longer mirror each "
                     f"other about it)")
+            spans = _param_spans(terms, t_old) if t_params_changed else []
+            for span, a, b in zip(spans, t_old.params, t_new.params):
+                comment = None if a == b else \
+                    _comment_after(text, starts[span.line - 1] + span.column - 1)
+                if comment is not None and comment not in marked:
+                    marked.add(comment)
+                    if not text[:comment[1]].endswith(BEFORE_TEACHING):
+                        edits.append((comment[1], comment[1], BEFORE_TEACHING))
+                        said.append(f"its comment marked `{BEFORE_TEACHING.strip()}`")
             if said:
                 changes.append(f"{v_old.name}.{t_old.name}: " + "; ".join(said))
             bare = not isinstance(terms[t_old.name], yamlpos.YMap)
             if not t_params_changed or (bare and was != now):   # (the flags' edit wrote it)
                 continue
-            spans = _param_spans(terms, t_old)
             for span, a, b in zip(spans, t_old.params, t_new.params):
                 if a == b:
                     continue
@@ -642,7 +682,7 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
             changes.append(f"new behavior {b.name} ({plural(len(b.rules), 'rule')})")
             continue
         place = places.get(b.name)
-        inserted = _edited_behavior(b, old, place, keep, path, edits, changes)
+        inserted = _edited_behavior(b, old, place, keep, text, path, edits, changes)
         if inserted:
             if place is None or place.end_line_start is None:
                 appended += inserted                      # top-level rules: at the end
@@ -660,11 +700,11 @@ def edit_rules(text: str, path: str, original: RuleBase, current: RuleBase,
 
 
 def _edited_behavior(b: Behavior, old: Behavior, place: _Place | None, keep: dict[str, str],
-                     path: str, edits: list[tuple[int, int, str]],
+                     text: str, path: str, edits: list[tuple[int, int, str]],
                      changes: list[str]) -> list[str]:
     """The edits (into ``edits``) of behavior ``b``'s rules, uses, operators and freezes
-    since ``old``, where the file at ``place`` writes it; returns the lines to insert at its
-    end (new rules, uses, operators and freezes)."""
+    since ``old``, where the file ``text`` at ``place`` writes it; returns the lines to
+    insert at its end (new rules, uses, operators and freezes)."""
     inserted: list[str] = []
     if keep:
         inserted.append("operators: " + ", ".join(f"{k} = {v}" for k, v in keep.items()))
@@ -686,8 +726,10 @@ def _edited_behavior(b: Behavior, old: Behavior, place: _Place | None, keep: dic
                               f"`{before.label or f'#{i + 1}'}` of behavior {b.name} is no "
                               f"longer there",
                               hint="start the lesson again on the file as it is now")
-        edits += _rule_edits(before, rule, *place.rules[i][1])
-        changes.append(f"{b.name}: {format_rule(rule)}")
+        rule_edits, marked = _rule_edits(text, before, rule, *place.rules[i][1])
+        edits += rule_edits
+        changes.append(f"{b.name}: {format_rule(rule)}"
+                       + (f"; its comment marked `{BEFORE_TEACHING.strip()}`" if marked else ""))
     for use in b.uses[len(old.uses):]:
         inserted.append(format_use(use))
         changes.append(f"{b.name}: {format_use(use)}")
@@ -710,21 +752,31 @@ def _edited_behavior(b: Behavior, old: Behavior, place: _Place | None, keep: dic
     return inserted
 
 
-def _rule_edits(before: Rule, rule: Rule, start: int, end: int,
-                crisp: dict[str, tuple[int, int]]) -> list[tuple[int, int, str]]:
-    """``before``, written at ``start:end``, changed into ``rule``: where only crisp values
-    changed, those numbers (at ``crisp``, by output) and the rest of the line as the
-    instructor wrote it; else the whole rule."""
+def _rule_edits(text: str, before: Rule, rule: Rule, start: int, end: int,
+                crisp: dict[str, tuple[int, int]]) -> tuple[list[tuple[int, int, str]], bool]:
+    """``before``, written at ``start:end`` of ``text``, changed into ``rule``: where only
+    crisp values changed (learned), those numbers (at ``crisp``, by output) and the rest of
+    the line as the instructor wrote it, a comment on a changed number's line marked
+    ``(before teaching)``; else the whole rule (told again: the comment after it is the
+    instructor's). The edits, and whether a comment was marked."""
     if not (_only_crisp_changed(before, rule)
             and all(c.var in crisp for c in rule.consequents if c.term is None)):
-        return [(start, end, format_rule(rule))]
+        return [(start, end, format_rule(rule))], False
     edits = []
+    marked: set[tuple[int, int]] = set()
+    said = False
     for c_old, c_new in zip(before.consequents, rule.consequents):
         if c_old.value != c_new.value:
             assert c_new.value is not None   # same terms, so a crisp value changed
             s, e = crisp[c_new.var]
             edits.append((s, e, format_number(c_new.value)))
-    return edits
+            comment = _comment_after(text, e, yaml=False)
+            if comment is not None and comment not in marked:
+                marked.add(comment)
+                if not text[:comment[1]].endswith(BEFORE_TEACHING):
+                    edits.append((comment[1], comment[1], BEFORE_TEACHING))
+                    said = True
+    return edits, said
 
 
 def _operators_text(settings: Iterable[Setting]) -> str:
