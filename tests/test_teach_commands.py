@@ -231,6 +231,50 @@ def test_a_target_is_not_offered_a_with_it_refuses(line):
     assert info.value.expected == "`and` or the end of the line"
 
 
+TARGET_HEDGES = "a hedge (very, extremely, somewhat, more_or_less)"
+
+
+@pytest.mark.parametrize("line, message, expected", [
+    # a target cut short after `is` (or a hedge): it offered every hedge of a rule's condition,
+    # `seldom, intensely, any` among them, which the target then refused ("`seldom LM` has no
+    # meaning for a target value")
+    ("at 13s to 14.5s steering is", "the line ends too early",
+     f"{TARGET_HEDGES}, a name or a number"),
+    ("correct road=78 -> steering is very", "the line ends too early",
+     f"{TARGET_HEDGES} or a name"),
+    ("at 13s steering is extremely", "the line ends too early", f"{TARGET_HEDGES} or a name"),
+    ("correct road=78 -> steering is very 5", "unexpected `5`", f"{TARGET_HEDGES} or a name"),
+])
+def test_a_target_is_offered_only_the_hedges_it_takes(line, message, expected):
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line)
+    assert info.value.message == message
+    assert info.value.expected == expected
+
+
+def test_a_rule_is_still_offered_every_hedge():
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("if road is")
+    assert "seldom, intensely, any" in info.value.expected
+
+
+@pytest.mark.parametrize("line, hint", [
+    # a word before the term that is no hedge and close to none: no hint at all, where a rule's
+    # condition says the same (`road is sligthly WIDE`: "a term's name is one word ...")
+    ("correct road=78 -> steering is sligthly LM",
+     "`sligthly LM`: a term's name is one word (`sligthly_LM`), and `sligthly` is not a hedge "
+     "of a target (very, extremely, somewhat, more_or_less), which would stand before the term"),
+    ("at 13s to 14s speed is rather SLOW",
+     "`rather SLOW`: a term's name is one word (`rather_SLOW`), and `rather` is not a hedge of "
+     "a target (very, extremely, somewhat, more_or_less), which would stand before the term"),
+])
+def test_two_words_in_a_target_are_said_to_be_one_term_or_a_hedge(line, hint):
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line)
+    assert info.value.expected == "`and` or the end of the line"
+    assert info.value.hint == hint
+
+
 @pytest.mark.parametrize("line, message, column, hint", [
     ("correct road=0x1F size=45 position=4 -> steering=60", "`road` must be a number, not "
      "`0x1F`", 14, None),

@@ -391,10 +391,11 @@ def joined_hint(text: str, token: Token) -> str | None:
     return None
 
 
-def _two_words(text: str, token: Token) -> str | None:
+def _two_words(text: str, token: Token, allowed: tuple[str, ...] | None = None) -> str | None:
     """``position is FAR RIGHT``: two words after `is`, the first neither a hedge nor close to
     one (``vary``: :func:`_hedge_hint`). A term's name is one word; a missing `and` before a
-    new condition (``road is WIDE size is ...``) is not this: there `is` follows."""
+    new condition (``road is WIDE size is ...``) is not this: there `is` follows. ``allowed``:
+    the hedges that may stand there, as for :func:`_hedge_hint` (a teaching target's)."""
     from ..fuzzy.hedges import HEDGES
 
     before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$", text[:token.start_pos])
@@ -403,8 +404,9 @@ def _two_words(text: str, token: Token) -> str | None:
     if re.match(r"\s*is\b", text[token.end_pos:]):
         return None
     word = before.group(1)
+    pool, which = (HEDGES, "a hedge") if allowed is None else (allowed, "a hedge of a target")
     return (f"`{word} {token}`: a term's name is one word (`{word}_{token}`), and `{word}` is "
-            f"not a hedge ({', '.join(HEDGES)}), which would stand before the term")
+            f"not {which} ({', '.join(pool)}), which would stand before the term")
 
 
 def _keyword_as_term(text: str, token: Token) -> str | None:

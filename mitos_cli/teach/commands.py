@@ -29,6 +29,7 @@ from ..lang.parse import (
     UNSAID,
     _hedge_hint,
     _ToModel,
+    _two_words,
     _unquote,
     check_modifiers,
     check_nesting,
@@ -54,7 +55,7 @@ if TYPE_CHECKING:
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
              SIGNED_NUMBER="a number", SEED="a seed (a whole number)", DOT="`.`",
-             SEED_WORD="`seed`",
+             SEED_WORD="`seed`", TARGET_HEDGE="a hedge (" + ", ".join(HEDGE_STEPS) + ")",
              **{"$END": "the end of the line", "<END-OF-FILE>": "the end of the line"})
 
 #: Every command word, for completion and ``help``.
@@ -661,6 +662,11 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
                                expected=_expected(exc.allowed or ()),
                                hint=FIRST_WORDS_HINT if exc.column == 1 else None)
     expected = set(getattr(exc, "expected", None) or ())
+    words = text.split()
+    if ("->" in words or words[:1] == ["at"]) and "HEDGE" in expected:
+        # a target takes only the hedges that move a value along its scale: offered every
+        # hedge of a rule's condition, it then refused `seldom LM` (no meaning for a target)
+        expected = expected - {"HEDGE"} | {"TARGET_HEDGE"}
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         line = len(lines_of(text.rstrip())) or 1
@@ -786,7 +792,10 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
             return (f"`{said}` is an instruction, not a term: say it alone after the window, "
                     f"{where}{said}`" + (", not after inputs" if "->" in before else ""))
     if "->" in before or before[:1] == ["at"]:            # targets: the hedges they take
-        return _hedge_hint(text, token, tuple(HEDGE_STEPS))
+        if re.match(r"\s*=", text[token.end_pos or 0:]):   # `steering is LB speed=3`
+            return _hedge_hint(text, token, tuple(HEDGE_STEPS))
+        return _hedge_hint(text, token, tuple(HEDGE_STEPS)) or \
+            _two_words(text, token, tuple(HEDGE_STEPS))
     return _hedge_hint(text, token)                      # a rule's condition: any hedge
 
 
