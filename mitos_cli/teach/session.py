@@ -734,6 +734,7 @@ class Session:
             ins = instruction(c.words)
         except LessonError as exc:
             exc.span = c.span
+            exc.hint = self._output_said(c.words) or exc.hint
             raise
         rec = self._recording()
         compiled = self._driver(rec)
@@ -759,6 +760,19 @@ class Session:
                  f"{text.num(float(wanted[first]))} at {rec.time(rows[first]):g} s)")
         self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
                          [{ins.output: float(wanted[i])} for i in keep], line)
+
+    def _output_said(self, words: tuple[str, ...]) -> str | None:
+        """What to write when an `at` line names an output where an instruction goes, alone
+        or with one of its terms but no `is` (`at 13s steering`, `at 13s speed SLOW`)."""
+        var = self.rulebase.variables.get(words[0])
+        if var is None or var.role != "output" or len(words) > 2:
+            return None
+        names = [t.name for t in var.terms]
+        if len(words) == 2 and words[1] not in names:
+            return None
+        said = (f"`{var.name} is {words[1]}`" if len(words) == 2 else
+                f"`{var.name} is TERM` (`{var.name} is {names[0]}`)")
+        return f"say what `{var.name}` should be: {said} or `{var.name}=VALUE`"
 
     def use_advice(self, name: str) -> str:
         """How to make behavior ``name`` the active one now: `use NAME`, but while a behavior
