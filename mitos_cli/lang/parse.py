@@ -114,6 +114,20 @@ def keyword_hint(token: Token, expected: Iterable[str]) -> str | None:
     return did_you_mean(value, words) if words and value.isidentifier() else None
 
 
+def _frozen_term(text: str, pos: int) -> str | None:
+    """``frozen heading.AHEAD`` in a rule file, at the `.` (``pos``): the teaching prompt
+    freezes terms so, but a rule file freezes rules; a term, in its term set."""
+    label = re.search(r"\bfrozen[ \t]+(?:[\w\-]+[ \t]*,[ \t]*)*([A-Za-z_][\w\-]*)\Z",
+                      text[:pos])
+    term = re.match(r"\.([A-Za-z_][\w\-]*)", text[pos:])
+    if label is None or term is None:
+        return None
+    var, name = label.group(1), term.group(1)
+    return (f"a rule file freezes rules (`frozen r1`); a term is frozen in its term set, "
+            f"`frozen: true` on `{name}` of `{var}` (`frozen {var}.{name}` is a `mitos teach` "
+            "command)")
+
+
 def _describe(token: Token) -> str:
     if token.type == "$END":
         return "the end of the input"
@@ -136,6 +150,8 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
         elif char == ";":                               # FCL's `... then speed is SLOW;`
             hint = ("a rule needs no `;` at its end (FCL's rules have one: `mitos convert "
                     "FILE.fcl --to rules` reads an FCL file)")
+        elif char == "." and (frozen := _frozen_term(text, pos)) is not None:
+            hint = frozen
         return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
                                expected=allowed, hint=hint)
     if isinstance(exc, UnexpectedInput):
