@@ -159,6 +159,12 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`make a wider turn` is an instruction, not a term: say it alone after the window, "
      "`at 13s to 14.5s make a wider turn`"),
     ("at 12s speed is slow down", "unexpected `down`", None, "`at 12s slow down`"),
+    # an instruction and a target on one line: it was "unexpected `=`, expected a name" alone
+    ("at 13s to 14.5s turn harder steering=50", "unexpected `=`", None,
+     "one correction per `at` line: the instruction, `at 13s to 14.5s turn harder`, or the "
+     "target, `at 13s to 14.5s steering=50`, each on a line of its own"),
+    ("at 2s slow down speed=10", "unexpected `=`", None,
+     "`at 2s slow down`, or the target, `at 2s speed=10`"),
     # a bare instruction: it is no command; the window, and the list
     ("turn harder", "unknown command `turn`: an instruction takes a window of the recorded "
      "run, `at 13s to 14.5s turn harder`", "`turn harder`, `turn less`, `make a wider turn`, "

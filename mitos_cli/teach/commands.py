@@ -778,6 +778,16 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
             re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)
             for word in (before[1], "".join(before[1:3]))):
         return TIME_HINT
+    if before[:1] == ["at"] and str(token.value) == "=" and len(before) > 2:
+        # `at 13s to 14.5s turn harder steering=50`: an instruction and a target on one line
+        window = before[:4] if before[2:3] == ["to"] else before[:2]
+        words = before[len(window):]
+        said = starts_instruction(words[:-1])
+        if said is not None and words[:-1] == said.split():
+            head = " ".join(window)
+            value = text[token.end_pos or 0:].split()[:1] or ["VALUE"]
+            return (f"one correction per `at` line: the instruction, `{head} {said}`, or the "
+                    f"target, `{head} {words[-1]}={value[0]}`, each on a line of its own")
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
