@@ -430,6 +430,31 @@ def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
         assert help_text(word) == help_text("correct")
 
 
+def test_help_at_says_what_each_instruction_does():
+    """`help at` named the instructions and sent the reader to docs/teach.md, which `pip
+    install` does not copy: it says each one's transformation, from the registry."""
+    from mitos_cli.teach.help import help_text
+    from mitos_cli.teach.instructions import INSTRUCTIONS
+
+    text = help_text("at")
+    assert "docs/teach.md" not in text
+    lines = text.splitlines()
+    for phrase, ins in INSTRUCTIONS.items():
+        assert f"  {phrase:<28}{ins.meaning}" in lines
+    assert "  make a wider turn           the hardest steering of the window, one term further, " \
+           "at every tick" in lines
+
+
+def test_help_save_says_where_a_bare_save_goes():
+    """A bare `save` writes where the last `save` went (also after `--resume`), else the
+    `--save-as` file: `help save` said only "default: the --save-as file"."""
+    from mitos_cli.teach.help import help_text
+
+    text = " ".join(help_text("save").split())
+    assert "default: where the last `save` went, also after `mitos teach --resume`, else the " \
+           "--save-as file" in text
+
+
 def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
     s, out = session(rules)
     s.run("use drive")
