@@ -189,6 +189,18 @@ def test_frozen_in_a_behavior_without_rules_names_the_behavior_that_has_the_rule
     assert caught.value.hint == "`drive` has no rules of its own"
 
 
+def test_frozen_names_a_variable_where_its_terms_go(rules):
+    """`frozen heading` (a variable, where a rule's label or a term goes) said "unknown rule
+    label `heading`" with the labels alone: a variable's terms are frozen one by one."""
+    s, _ = session(rules)
+    with pytest.raises(NameError_) as caught:
+        s.run("frozen position")
+    assert caught.value.message == "unknown rule label `position` of `avoid_obstacle`"
+    assert caught.value.hint == ("`position` is a variable: freeze its terms, `frozen "
+                                 "position.LEFT, position.CENTER, position.RIGHT` (or one of "
+                                 "them: `frozen position.LEFT`)")
+
+
 def test_frozen_and_operators(rules):
     s, out = session(rules)
     assert "leaves the consequents of r4, r5 alone" in say(s, out, "frozen r4, r5")

@@ -530,7 +530,13 @@ class Session:
         close, the hint names the behavior that has it (`drive` has no rules of its own: it
         uses the behaviors that do)."""
         exc = unknown("rule label", label, labels, owner=b.name)
-        if exc.hint is None:
+        var = self.rulebase.variables.get(label)
+        if var is not None and var.terms:           # `frozen heading`: its terms, one by one
+            terms = [f"{label}.{t.name}" for t in var.terms]
+            shown = ", ".join(terms[:5]) + (", ..." if len(terms) > 5 else "")
+            exc.hint = (f"`{label}` is a variable: freeze its terms, `frozen {shown}` (or one "
+                        f"of them: `frozen {terms[0]}`)")
+        elif exc.hint is None:
             owners = [o.name for o in self.rulebase.behaviors
                       if o.name != b.name and any(r.label == label for r in o.rules)]
             own = "" if labels else f"`{b.name}` has no rules of its own; "
