@@ -830,6 +830,24 @@ def test_an_output_the_behavior_does_not_set_is_said_alike_in_words(rules):
         assert info.value.expected == "outputs steering"
 
 
+@pytest.mark.parametrize("line, message, hint", [
+    # an input given as a target (`at 13s road=3`: the road the robot should have seen) and an
+    # output given as an input: "unknown output variable `road`" with the outputs alone
+    ("correct road=78 size=45 position=4 -> road=60", "unknown output variable `road`",
+     "`road` is an input: a target sets an output (steering, speed); the inputs are given "
+     "before `->` (in `at`, the run gives them)"),
+    ("correct road=78 size=45 steering=60 -> speed=3", "unknown input variable `steering`",
+     "`steering` is an output: it goes after `->`, as a target (`-> steering=VALUE`)"),
+])
+def test_an_input_said_as_a_target_or_an_output_as_an_input_is_said_so(rules, line, message,
+                                                                         hint):
+    s, _ = session(rules)
+    with pytest.raises(LessonError) as info:
+        s.run(line)
+    assert info.value.message == message
+    assert info.value.hint == hint
+
+
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):
     """`simulate` is journaled (a record, not a change): `--resume` drives the last run again
     on the rule base as it was then, so `at` corrects the same run; a seed is exact."""

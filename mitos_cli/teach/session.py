@@ -1179,6 +1179,13 @@ def _not_its(name: str, span: Span | None, role: str, names: tuple[str, ...],
                            span=span, expected=f"{role}s " + ", ".join(names))
     error = unknown(f"{role} variable", name, names, span=span, cls=LessonError)
     assert isinstance(error, LessonError)
+    other = compiled.variables.get(name)
+    if error.hint is None and other is not None:    # an input as a target, or the reverse
+        error.hint = (f"`{name}` is an input: a target sets an output ({', '.join(names)}); the "
+                      "inputs are given before `->` (in `at`, the run gives them)"
+                      if role == "output" else
+                      f"`{name}` is an output: it goes after `->`, as a target "
+                      f"(`-> {name}=VALUE`)")
     return error
 
 
