@@ -159,6 +159,16 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`make a wider turn` is an instruction, not a term: say it alone after the window, "
      "`at 13s to 14.5s make a wider turn`"),
     ("at 12s speed is slow down", "unexpected `down`", None, "`at 12s slow down`"),
+    # a window written otherwise: `at13s` (glued: "type `help`"), `from 13s to 14s` ("did you
+    # mean `frozen`?"), `at 13s until 14s` ("give values as NAME=VALUE")
+    ("at13s turn harder", "unknown command `at13s`", None,
+     "`at` and `13s` are two words: `at 13s turn harder`"),
+    ("from 13s to 14s turn harder", "unknown command `from`", None,
+     "a window of the recorded run is written `at 13s to 14s ...`"),
+    ("at 13s until 14s turn harder", "unexpected `14`", None,
+     "a window is written `at 13s to 14s`: the word between its times is `to`"),
+    ("at 13s - 14s steering=50", "unexpected `-`", None,
+     "a window is written `at 13s to 14s`: the word between its times is `to`"),
     # an instruction and a target on one line: it was "unexpected `=`, expected a name" alone
     ("at 13s to 14.5s turn harder steering=50", "unexpected `=`", None,
      "one correction per `at` line: the instruction, `at 13s to 14.5s turn harder`, or the "

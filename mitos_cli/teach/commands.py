@@ -599,7 +599,30 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
                                     + ", ".join(COMMAND_WORDS),
                            hint=(f"a rule label ends with a colon: `{word}: if ...`"
                                  if line[match.end():].split()[:1] == ["if"] else
+                                 _window_said_otherwise(line.split()) or
                                  did_you_mean(word, COMMAND_WORDS + ("if",)) or "type `help`"))
+
+
+#: Words said between a window's times for `to` (`at 13s until 14s`).
+_TO_SAID_OTHERWISE = frozenset({"until", "till", "til", "through", "thru", "and", "upto"})
+#: A time as a window writes it: a decimal number of seconds, with or without `s`.
+_TIME = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?s?"
+
+
+def _window_said_otherwise(words: list[str]) -> str | None:
+    """A window of the recorded run written otherwise than `at START [to END]`: `at` glued to
+    its time (`at13s`: "type `help`"), or `from 13s to 14s` ("did you mean `frozen`?")."""
+    glued = re.fullmatch(rf"at({_TIME})", words[0])
+    if glued is not None:
+        return (f"`at` and `{glued.group(1)}` are two words: `"
+                + " ".join(["at", glued.group(1), *words[1:]]) + "`")
+    if words[0] in ("from", "between", "during") and len(words) > 1 \
+            and re.fullmatch(_TIME, words[1]):
+        if len(words) > 3 and re.fullmatch(_TIME, words[3]):
+            return f"a window of the recorded run is written `at {words[1]} to {words[3]} ...`"
+        return f"a tick of the recorded run is named `at {words[1]} ...` (a window: `at START " \
+               "to END ...`)"
+    return None
 
 
 #: The instructions, as messages list them.
@@ -778,6 +801,13 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
             re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)
             for word in (before[1], "".join(before[1:3]))):
         return TIME_HINT
+    if before[:1] == ["at"] and len(before) in (2, 3) and re.fullmatch(_TIME, before[1]) and (
+            len(before) == 3 and before[2] in _TO_SAID_OTHERWISE and re.match(_TIME, text[at:])
+            or len(before) == 2 and str(token.value).startswith("-")):
+        # `at 13s until 14s`, `at 13s - 14s`: the word between the times read as an output
+        end = re.match(_TIME, text[at:].lstrip("-").lstrip())
+        return (f"a window is written `at {before[1]} to {end.group(0) if end else 'END'}`: "
+                "the word between its times is `to`")
     if before[:1] == ["at"] and str(token.value) == "=" and len(before) > 2:
         # `at 13s to 14.5s turn harder steering=50`: an instruction and a target on one line
         window = before[:4] if before[2:3] == ["to"] else before[:2]
