@@ -345,6 +345,20 @@ def test_an_output_named_as_an_instruction_is_said_to_need_is_or_a_value(said, h
     assert info.value.hint == hint
 
 
+def test_a_window_between_two_ticks_names_the_ticks_around_it():
+    """`at 13.01s to 13.02s` said "no recorded tick between 13.01 s and 13.02 s" alone."""
+    from mitos_cli.teach.session import Session
+
+    s = Session(default_rulebase_path(), out=[].append)
+    s.run("use drive")
+    s.run("simulate figure4")
+    with pytest.raises(LessonError) as info:
+        s.run("at 13.01s to 13.02s turn harder")
+    assert info.value.message == "no recorded tick between 13.01 s and 13.02 s"
+    assert info.value.hint == ("the ticks of the run are 0.05 s apart: the nearest are at 13 s "
+                               "and 13.05 s (`at 13.01s` alone takes the nearest tick)")
+
+
 def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
 
