@@ -247,6 +247,17 @@ def test_a_target_is_not_offered_a_with_it_refuses(line):
     assert info.value.expected == "`and` or the end of the line"
 
 
+def test_an_arrow_in_an_at_line_is_not_taken_for_a_window():
+    """`at 13s - 14s` is said to be a window written with `to`; the arrow of `correct ... ->`
+    copied into an `at` line is said to be none of `at`'s (it would have been told "a window is
+    written `at 13s to END`")."""
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("at 13s -> steering=50")
+    assert info.value.message == "unexpected `->`"
+    assert info.value.hint == "`at` takes no `->`: its targets follow the time, `at 13s " \
+        "steering=50`"
+
+
 TARGET_HEDGES = "a hedge (very, extremely, somewhat, more_or_less)"
 
 

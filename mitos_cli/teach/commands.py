@@ -803,11 +803,14 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
         return TIME_HINT
     if before[:1] == ["at"] and len(before) in (2, 3) and re.fullmatch(_TIME, before[1]) and (
             len(before) == 3 and before[2] in _TO_SAID_OTHERWISE and re.match(_TIME, text[at:])
-            or len(before) == 2 and str(token.value).startswith("-")):
+            or len(before) == 2 and re.fullmatch(rf"-(?:{_TIME})?", str(token.value))):
         # `at 13s until 14s`, `at 13s - 14s`: the word between the times read as an output
         end = re.match(_TIME, text[at:].lstrip("-").lstrip())
         return (f"a window is written `at {before[1]} to {end.group(0) if end else 'END'}`: "
                 "the word between its times is `to`")
+    if before[:1] == ["at"] and str(token.value) == "->":   # `correct`'s arrow, copied
+        rest = text[token.end_pos or 0:].strip()
+        return f"`at` takes no `->`: its targets follow the time, `{' '.join(before)} {rest}`"
     if before[:1] == ["at"] and str(token.value) == "=" and len(before) > 2:
         # `at 13s to 14.5s turn harder steering=50`: an instruction and a target on one line
         window = before[:4] if before[2:3] == ["to"] else before[:2]
