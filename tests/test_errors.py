@@ -94,6 +94,12 @@ def caret_under(exc: MitosError) -> str:
      "write `speed is ...`"),
     ("r1: if road is WIDE then speed is SLOW;", 39, ";", "unexpected character `;`", None,
      "a rule needs no `;` at its end"),
+    # a term frozen as the teaching prompt freezes it (`frozen heading.AHEAD`): a rule file
+    # freezes rules, and a term in its term set; it said "expected `,` or a name" alone
+    ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n  frozen r1, road.WIDE\n", 18,
+     ".", "unexpected character `.`", "`,` or a name",
+     "a rule file freezes rules (`frozen r1`); a term is frozen in its term set, `frozen: true` "
+     "on `WIDE` of `road` (`frozen road.WIDE` is a `mitos teach` command)"),
     ("behavior b:\n  r1: if road is WIDE then speed is SLOW\n", 41, None,
      "unexpected end of the input", "`end`", "a behavior ends with `end`"),
     # a misspelt statement keyword is read as a rule's label: the word is reported, with

@@ -159,6 +159,22 @@ def test_rule_lines_are_rules_of_the_rule_language():
      "`make a wider turn` is an instruction, not a term: say it alone after the window, "
      "`at 13s to 14.5s make a wider turn`"),
     ("at 12s speed is slow down", "unexpected `down`", None, "`at 12s slow down`"),
+    # a window written otherwise: `at13s` (glued: "type `help`"), `from 13s to 14s` ("did you
+    # mean `frozen`?"), `at 13s until 14s` ("give values as NAME=VALUE")
+    ("at13s turn harder", "unknown command `at13s`", None,
+     "`at` and `13s` are two words: `at 13s turn harder`"),
+    ("from 13s to 14s turn harder", "unknown command `from`", None,
+     "a window of the recorded run is written `at 13s to 14s ...`"),
+    ("at 13s until 14s turn harder", "unexpected `14`", None,
+     "a window is written `at 13s to 14s`: the word between its times is `to`"),
+    ("at 13s - 14s steering=50", "unexpected `-`", None,
+     "a window is written `at 13s to 14s`: the word between its times is `to`"),
+    # an instruction and a target on one line: it was "unexpected `=`, expected a name" alone
+    ("at 13s to 14.5s turn harder steering=50", "unexpected `=`", None,
+     "one correction per `at` line: the instruction, `at 13s to 14.5s turn harder`, or the "
+     "target, `at 13s to 14.5s steering=50`, each on a line of its own"),
+    ("at 2s slow down speed=10", "unexpected `=`", None,
+     "`at 2s slow down`, or the target, `at 2s speed=10`"),
     # a bare instruction: it is no command; the window, and the list
     ("turn harder", "unknown command `turn`: an instruction takes a window of the recorded "
      "run, `at 13s to 14.5s turn harder`", "`turn harder`, `turn less`, `make a wider turn`, "
@@ -229,6 +245,61 @@ def test_a_target_is_not_offered_a_with_it_refuses(line):
     with pytest.raises(RuleSyntaxError) as info:
         parse_command(line)
     assert info.value.expected == "`and` or the end of the line"
+
+
+def test_an_arrow_in_an_at_line_is_not_taken_for_a_window():
+    """`at 13s - 14s` is said to be a window written with `to`; the arrow of `correct ... ->`
+    copied into an `at` line is said to be none of `at`'s (it would have been told "a window is
+    written `at 13s to END`")."""
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("at 13s -> steering=50")
+    assert info.value.message == "unexpected `->`"
+    assert info.value.hint == "`at` takes no `->`: its targets follow the time, `at 13s " \
+        "steering=50`"
+
+
+TARGET_HEDGES = "a hedge (very, extremely, somewhat, more_or_less)"
+
+
+@pytest.mark.parametrize("line, message, expected", [
+    # a target cut short after `is` (or a hedge): it offered every hedge of a rule's condition,
+    # `seldom, intensely, any` among them, which the target then refused ("`seldom LM` has no
+    # meaning for a target value")
+    ("at 13s to 14.5s steering is", "the line ends too early",
+     f"{TARGET_HEDGES}, a name or a number"),
+    ("correct road=78 -> steering is very", "the line ends too early",
+     f"{TARGET_HEDGES} or a name"),
+    ("at 13s steering is extremely", "the line ends too early", f"{TARGET_HEDGES} or a name"),
+    ("correct road=78 -> steering is very 5", "unexpected `5`", f"{TARGET_HEDGES} or a name"),
+])
+def test_a_target_is_offered_only_the_hedges_it_takes(line, message, expected):
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line)
+    assert info.value.message == message
+    assert info.value.expected == expected
+
+
+def test_a_rule_is_still_offered_every_hedge():
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command("if road is")
+    assert "seldom, intensely, any" in info.value.expected
+
+
+@pytest.mark.parametrize("line, hint", [
+    # a word before the term that is no hedge and close to none: no hint at all, where a rule's
+    # condition says the same (`road is sligthly WIDE`: "a term's name is one word ...")
+    ("correct road=78 -> steering is sligthly LM",
+     "`sligthly LM`: a term's name is one word (`sligthly_LM`), and `sligthly` is not a hedge "
+     "of a target (very, extremely, somewhat, more_or_less), which would stand before the term"),
+    ("at 13s to 14s speed is rather SLOW",
+     "`rather SLOW`: a term's name is one word (`rather_SLOW`), and `rather` is not a hedge of "
+     "a target (very, extremely, somewhat, more_or_less), which would stand before the term"),
+])
+def test_two_words_in_a_target_are_said_to_be_one_term_or_a_hedge(line, hint):
+    with pytest.raises(RuleSyntaxError) as info:
+        parse_command(line)
+    assert info.value.expected == "`and` or the end of the line"
+    assert info.value.hint == hint
 
 
 @pytest.mark.parametrize("line, message, column, hint", [

@@ -325,6 +325,40 @@ def test_two_instructions_joined_by_and_are_said_one_per_line():
                                "then `at ... slow down` (same window)")
 
 
+@pytest.mark.parametrize("said, hint", [
+    # an output named alone, or with a term of it but no `is`: it was "unknown instruction
+    # `steering`", hint "docs/teach.md defines each instruction" (and `speed SLOW`: "did you
+    # mean `speed up`?")
+    ("steering", "say what `steering` should be: `steering is TERM` (`steering is LB`) or "
+     "`steering=VALUE`"),
+    ("speed SLOW", "say what `speed` should be: `speed is SLOW` or `speed=VALUE`"),
+])
+def test_an_output_named_as_an_instruction_is_said_to_need_is_or_a_value(said, hint):
+    from mitos_cli.teach.session import Session
+
+    s = Session(default_rulebase_path(), out=[].append)
+    s.run("use drive")
+    s.run("simulate figure4")
+    with pytest.raises(LessonError) as info:
+        s.run(f"at 13s to 14s {said}")
+    assert info.value.message == f"unknown instruction `{said}`"
+    assert info.value.hint == hint
+
+
+def test_a_window_between_two_ticks_names_the_ticks_around_it():
+    """`at 13.01s to 13.02s` said "no recorded tick between 13.01 s and 13.02 s" alone."""
+    from mitos_cli.teach.session import Session
+
+    s = Session(default_rulebase_path(), out=[].append)
+    s.run("use drive")
+    s.run("simulate figure4")
+    with pytest.raises(LessonError) as info:
+        s.run("at 13.01s to 13.02s turn harder")
+    assert info.value.message == "no recorded tick between 13.01 s and 13.02 s"
+    assert info.value.hint == ("the ticks of the run are 0.05 s apart: the nearest are at 13 s "
+                               "and 13.05 s (`at 13.01s` alone takes the nearest tick)")
+
+
 def test_scale_centre_is_the_mirror_point():
     assert scale_of(PAPER.variables["steering"]).centre == 3.0       # ST
 

@@ -189,6 +189,18 @@ def test_frozen_in_a_behavior_without_rules_names_the_behavior_that_has_the_rule
     assert caught.value.hint == "`drive` has no rules of its own"
 
 
+def test_frozen_names_a_variable_where_its_terms_go(rules):
+    """`frozen heading` (a variable, where a rule's label or a term goes) said "unknown rule
+    label `heading`" with the labels alone: a variable's terms are frozen one by one."""
+    s, _ = session(rules)
+    with pytest.raises(NameError_) as caught:
+        s.run("frozen position")
+    assert caught.value.message == "unknown rule label `position` of `avoid_obstacle`"
+    assert caught.value.hint == ("`position` is a variable: freeze its terms, `frozen "
+                                 "position.LEFT, position.CENTER, position.RIGHT` (or one of "
+                                 "them: `frozen position.LEFT`)")
+
+
 def test_frozen_and_operators(rules):
     s, out = session(rules)
     assert "leaves the consequents of r4, r5 alone" in say(s, out, "frozen r4, r5")
@@ -428,6 +440,31 @@ def test_help_on_an_instruction_or_a_target_is_the_help_that_holds_it():
     assert "make a wider turn" in help_text("turn")
     for word in ("target", "targets", "hedges"):
         assert help_text(word) == help_text("correct")
+
+
+def test_help_at_says_what_each_instruction_does():
+    """`help at` named the instructions and sent the reader to docs/teach.md, which `pip
+    install` does not copy: it says each one's transformation, from the registry."""
+    from mitos_cli.teach.help import help_text
+    from mitos_cli.teach.instructions import INSTRUCTIONS
+
+    text = help_text("at")
+    assert "docs/teach.md" not in text
+    lines = text.splitlines()
+    for phrase, ins in INSTRUCTIONS.items():
+        assert f"  {phrase:<28}{ins.meaning}" in lines
+    assert "  make a wider turn           the hardest steering of the window, one term further, " \
+           "at every tick" in lines
+
+
+def test_help_save_says_where_a_bare_save_goes():
+    """A bare `save` writes where the last `save` went (also after `--resume`), else the
+    `--save-as` file: `help save` said only "default: the --save-as file"."""
+    from mitos_cli.teach.help import help_text
+
+    text = " ".join(help_text("save").split())
+    assert "default: where the last `save` went, also after `mitos teach --resume`, else the " \
+           "--save-as file" in text
 
 
 def test_simulate_and_at_and_their_mistakes(rules, tmp_path):
@@ -791,6 +828,24 @@ def test_an_output_the_behavior_does_not_set_is_said_alike_in_words(rules):
             s.run(f"correct heading=5 -> {target}")
         assert info.value.message == "behavior `follow_route` does not use output `speed`"
         assert info.value.expected == "outputs steering"
+
+
+@pytest.mark.parametrize("line, message, hint", [
+    # an input given as a target (`at 13s road=3`: the road the robot should have seen) and an
+    # output given as an input: "unknown output variable `road`" with the outputs alone
+    ("correct road=78 size=45 position=4 -> road=60", "unknown output variable `road`",
+     "`road` is an input: a target sets an output (steering, speed); the inputs are given "
+     "before `->` (in `at`, the run gives them)"),
+    ("correct road=78 size=45 steering=60 -> speed=3", "unknown input variable `steering`",
+     "`steering` is an output: it goes after `->`, as a target (`-> steering=VALUE`)"),
+])
+def test_an_input_said_as_a_target_or_an_output_as_an_input_is_said_so(rules, line, message,
+                                                                         hint):
+    s, _ = session(rules)
+    with pytest.raises(LessonError) as info:
+        s.run(line)
+    assert info.value.message == message
+    assert info.value.hint == hint
 
 
 def test_a_resumed_session_can_correct_the_run_it_recorded(tmp_path, monkeypatch):

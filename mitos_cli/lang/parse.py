@@ -114,6 +114,20 @@ def keyword_hint(token: Token, expected: Iterable[str]) -> str | None:
     return did_you_mean(value, words) if words and value.isidentifier() else None
 
 
+def _frozen_term(text: str, pos: int) -> str | None:
+    """``frozen heading.AHEAD`` in a rule file, at the `.` (``pos``): the teaching prompt
+    freezes terms so, but a rule file freezes rules; a term, in its term set."""
+    label = re.search(r"\bfrozen[ \t]+(?:[\w\-]+[ \t]*,[ \t]*)*([A-Za-z_][\w\-]*)\Z",
+                      text[:pos])
+    term = re.match(r"\.([A-Za-z_][\w\-]*)", text[pos:])
+    if label is None or term is None:
+        return None
+    var, name = label.group(1), term.group(1)
+    return (f"a rule file freezes rules (`frozen r1`); a term is frozen in its term set, "
+            f"`frozen: true` on `{name}` of `{var}` (`frozen {var}.{name}` is a `mitos teach` "
+            "command)")
+
+
 def _describe(token: Token) -> str:
     if token.type == "$END":
         return "the end of the input"
@@ -161,7 +175,8 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str | None) -> RuleSynta
 def _character_error(exc: UnexpectedCharacters, text: str, path: str | None
                      ) -> RuleSyntaxError:
     """A character the lexer cannot start a token with, with a hint where one is a common
-    slip (a name in non-ASCII letters, FCL's `;` at a rule's end)."""
+    slip (a name in non-ASCII letters, FCL's `;` at a rule's end, a term frozen as at the
+    prompt)."""
     line, column = exc.line, exc.column
     pos: int = exc.pos_in_stream  # type: ignore[assignment]  # lark declares None; the lexer sets an int
     char = text[pos] if pos < len(text) else ""
@@ -175,6 +190,8 @@ def _character_error(exc: UnexpectedCharacters, text: str, path: str | None
     elif char == ";":                               # FCL's `... then speed is SLOW;`
         hint = ("a rule needs no `;` at its end (FCL's rules have one: `mitos convert "
                 "FILE.fcl --to rules` reads an FCL file)")
+    elif char == "." and (frozen := _frozen_term(text, pos)) is not None:
+        hint = frozen
     return RuleSyntaxError(message, span=Span.in_text(text, path, line, column),
                            expected=allowed, hint=hint)
 
@@ -409,10 +426,11 @@ def joined_hint(text: str, token: Token) -> str | None:
     return None
 
 
-def _two_words(text: str, token: Token) -> str | None:
+def _two_words(text: str, token: Token, allowed: tuple[str, ...] | None = None) -> str | None:
     """``position is FAR RIGHT``: two words after `is`, the first neither a hedge nor close to
     one (``vary``: :func:`_hedge_hint`). A term's name is one word; a missing `and` before a
-    new condition (``road is WIDE size is ...``) is not this: there `is` follows."""
+    new condition (``road is WIDE size is ...``) is not this: there `is` follows. ``allowed``:
+    the hedges that may stand there, as for :func:`_hedge_hint` (a teaching target's)."""
     from ..fuzzy.hedges import HEDGES
 
     before = re.search(r"\bis\s+(?:not\s+)?([A-Za-z_][\w\-]*)\s*$", text[:token.start_pos])
@@ -421,8 +439,9 @@ def _two_words(text: str, token: Token) -> str | None:
     if re.match(r"\s*is\b", text[token.end_pos:]):
         return None
     word = before.group(1)
+    pool, which = (HEDGES, "a hedge") if allowed is None else (allowed, "a hedge of a target")
     return (f"`{word} {token}`: a term's name is one word (`{word}_{token}`), and `{word}` is "
-            f"not a hedge ({', '.join(HEDGES)}), which would stand before the term")
+            f"not {which} ({', '.join(pool)}), which would stand before the term")
 
 
 def _keyword_as_term(text: str, token: Token) -> str | None:

@@ -699,7 +699,9 @@ class Simulation:
 
     @property
     def active(self) -> np.ndarray:
-        """``[n]`` robots still driving."""
+        """``[n]`` robots not yet at their goal: a robot whose run ended otherwise (a
+        collision, stuck, out of time) keeps ``True`` (:attr:`robot_outcomes` says how each
+        ended; :attr:`done` whether the run has)."""
         return self._active.copy()
 
     @property

@@ -29,6 +29,7 @@ from ..lang.parse import (
     UNSAID,
     _hedge_hint,
     _ToModel,
+    _two_words,
     _unquote,
     check_modifiers,
     check_nesting,
@@ -54,7 +55,7 @@ if TYPE_CHECKING:
 WORDS = dict(TERMINAL_WORDS, PATH="a file name", INT="a whole number", ARROW="`->`",
              SHOW_WHAT="rules, terms, examples, behaviors or history", EQUAL="`=`",
              SIGNED_NUMBER="a number", SEED="a seed (a whole number)", DOT="`.`",
-             SEED_WORD="`seed`",
+             SEED_WORD="`seed`", TARGET_HEDGE="a hedge (" + ", ".join(HEDGE_STEPS) + ")",
              **{"$END": "the end of the line", "<END-OF-FILE>": "the end of the line"})
 
 #: Every command word, for completion and ``help``.
@@ -598,7 +599,30 @@ def _unknown_command(line: str, text: str, path: str, lineno: int) -> RuleSyntax
                                     + ", ".join(COMMAND_WORDS),
                            hint=(f"a rule label ends with a colon: `{word}: if ...`"
                                  if line[match.end():].split()[:1] == ["if"] else
+                                 _window_said_otherwise(line.split()) or
                                  did_you_mean(word, COMMAND_WORDS + ("if",)) or "type `help`"))
+
+
+#: Words said between a window's times for `to` (`at 13s until 14s`).
+_TO_SAID_OTHERWISE = frozenset({"until", "till", "til", "through", "thru", "and", "upto"})
+#: A time as a window writes it: a decimal number of seconds, with or without `s`.
+_TIME = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?s?"
+
+
+def _window_said_otherwise(words: list[str]) -> str | None:
+    """A window of the recorded run written otherwise than `at START [to END]`: `at` glued to
+    its time (`at13s`: "type `help`"), or `from 13s to 14s` ("did you mean `frozen`?")."""
+    glued = re.fullmatch(rf"at({_TIME})", words[0])
+    if glued is not None:
+        return (f"`at` and `{glued.group(1)}` are two words: `"
+                + " ".join(["at", glued.group(1), *words[1:]]) + "`")
+    if words[0] in ("from", "between", "during") and len(words) > 1 \
+            and re.fullmatch(_TIME, words[1]):
+        if len(words) > 3 and re.fullmatch(_TIME, words[3]):
+            return f"a window of the recorded run is written `at {words[1]} to {words[3]} ...`"
+        return f"a tick of the recorded run is named `at {words[1]} ...` (a window: `at START " \
+               "to END ...`)"
+    return None
 
 
 #: The instructions, as messages list them.
@@ -660,6 +684,11 @@ def _syntax_error(exc: UnexpectedInput, text: str, path: str) -> RuleSyntaxError
                                expected=_expected(exc.allowed or ()),
                                hint=FIRST_WORDS_HINT if exc.column == 1 else None)
     expected = set(getattr(exc, "expected", None) or ())
+    words = text.split()
+    if ("->" in words or words[:1] == ["at"]) and "HEDGE" in expected:
+        # a target takes only the hedges that move a value along its scale: offered every
+        # hedge of a rule's condition, it then refused `seldom LM` (no meaning for a target)
+        expected = expected - {"HEDGE"} | {"TARGET_HEDGE"}
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken)
                                           and exc.token.type == "$END"):
         return _end_error(text, path, expected)
@@ -792,6 +821,26 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
             re.fullmatch(r"[\d.]+(ms|sec|secs|seconds?|min|m|h)", word)
             for word in (before[1], "".join(before[1:3]))):
         return TIME_HINT
+    if before[:1] == ["at"] and len(before) in (2, 3) and re.fullmatch(_TIME, before[1]) and (
+            len(before) == 3 and before[2] in _TO_SAID_OTHERWISE and re.match(_TIME, text[at:])
+            or len(before) == 2 and re.fullmatch(rf"-(?:{_TIME})?", str(token.value))):
+        # `at 13s until 14s`, `at 13s - 14s`: the word between the times read as an output
+        end = re.match(_TIME, text[at:].lstrip("-").lstrip())
+        return (f"a window is written `at {before[1]} to {end.group(0) if end else 'END'}`: "
+                "the word between its times is `to`")
+    if before[:1] == ["at"] and str(token.value) == "->":   # `correct`'s arrow, copied
+        rest = text[token.end_pos or 0:].strip()
+        return f"`at` takes no `->`: its targets follow the time, `{' '.join(before)} {rest}`"
+    if before[:1] == ["at"] and str(token.value) == "=" and len(before) > 2:
+        # `at 13s to 14.5s turn harder steering=50`: an instruction and a target on one line
+        window = before[:4] if before[2:3] == ["to"] else before[:2]
+        words = before[len(window):]
+        said = starts_instruction(words[:-1])
+        if said is not None and words[:-1] == said.split():
+            head = " ".join(window)
+            value = text[token.end_pos or 0:].split()[:1] or ["VALUE"]
+            return (f"one correction per `at` line: the instruction, `{head} {said}`, or the "
+                    f"target, `{head} {words[-1]}={value[0]}`, each on a line of its own")
     if before[-2:] == ["is", "not"] and ("->" in before or before[:1] == ["at"]):
         return ("a target is a term, with hedges if need be (`steering is very LM`); `not` says "
                 "what it should not be, which is no target")
@@ -806,7 +855,10 @@ def _teach_hint(text: str, token: Token, before: list[str]) -> str | None:
             return (f"`{said}` is an instruction, not a term: say it alone after the window, "
                     f"{where}{said}`" + (", not after inputs" if "->" in before else ""))
     if "->" in before or before[:1] == ["at"]:            # targets: the hedges they take
-        return _hedge_hint(text, token, tuple(HEDGE_STEPS))
+        if re.match(r"\s*=", text[token.end_pos or 0:]):   # `steering is LB speed=3`
+            return _hedge_hint(text, token, tuple(HEDGE_STEPS))
+        return _hedge_hint(text, token, tuple(HEDGE_STEPS)) or \
+            _two_words(text, token, tuple(HEDGE_STEPS))
     return _hedge_hint(text, token)                      # a rule's condition: any hedge
 
 

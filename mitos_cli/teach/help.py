@@ -72,9 +72,12 @@ at 12.5s steering=55          one example: what the robot perceived at 12.5 s, a
                               it should have chosen
 at 11s to 13s steering=55     one example per recorded tick from 11 s to 13 s
 at 11s to 13s steering is LM  the same, in words
-at 13s to 14.5s make a wider turn    an instruction: what the robot did, transformed; one of
-    turn harder, turn less, make a wider turn, slow down, speed up,
-    keep further from the wall, keep right (`mitos docs teach` defines each)
+at 13s to 14.5s make a wider turn    an instruction: what the robot did at each tick of the
+                              window, transformed into a target (the examples are shown):
+{instructions}
+A term further moves along the output's terms sorted by value (steering LB 30, LM 50, ...,
+RB 150; smaller is to the left): 67 deg, 0.15 of the way from LS to LM, becomes 47 deg, 0.15
+of the way from LM to LB.
 `at` corrects the behavior that drove the run (the rules that produced the motion), also when
 another behavior is active now: `use` it before `adapt`.""",
     "adapt": """\
@@ -98,9 +101,10 @@ show terms plot FILE   also draw the terms that changed, before and after""",
 undo              take back the last change (a rule, an example, an adaptation, ...); repeat
                   to walk further back. Saved files are not touched.""",
     "save": """\
-save [PATH]       write PATH (default: the --save-as file) and its term set beside it
-                  (OUT.terms.yaml), changing only the numbers that were learned; the original
-                  files are overwritten only when you name them.""",
+save [PATH]       write PATH and its term set beside it (OUT.terms.yaml), changing only the
+                  numbers that were learned (default: where the last `save` went, also after
+                  `mitos teach --resume`, else the --save-as file); the original files are
+                  overwritten only when you name them.""",
     "quit": """\
 quit              leave the prompt (Ctrl-D too). Everything is in the journal under
                   .mitos/teach/; `mitos teach --resume` continues where you left off.""",
@@ -114,6 +118,13 @@ ALIASES = {"if": "rule", "rules": "rule", "end": "behavior", "exit": "quit", "te
            "hedges": "correct"}
 
 
+def _instructions() -> str:
+    """Each instruction of the registry and what it does, one line each."""
+    from .instructions import INSTRUCTIONS
+
+    return "\n".join(f"  {phrase:<28}{ins.meaning}" for phrase, ins in INSTRUCTIONS.items())
+
+
 def help_text(topic: str | None = None) -> str:
     if topic is None or topic == "help":
         return SUMMARY
@@ -122,4 +133,4 @@ def help_text(topic: str | None = None) -> str:
         error = unknown("help topic", topic, TOPICS, cls=LessonError)
         error.expected = "one of " + ", ".join(sorted(TOPICS))   # all of them: a short list
         raise error
-    return TOPICS[key]
+    return TOPICS[key].replace("{instructions}", _instructions())

@@ -231,7 +231,8 @@ def instruction(words: tuple[str, ...]) -> Instruction:
     raise LessonError(f"unknown instruction `{text}`",
                       expected="one of " + ", ".join(f"`{k}`" for k in INSTRUCTIONS)
                       + ", or `OUTPUT is TERM`, or `OUTPUT=VALUE`",
-                      hint=close or "`mitos docs teach` defines each instruction")
+                      hint=close or "`help at` (at the prompt) and `mitos docs teach` say what "
+                                    "each one does")
 
 
 def targets(ins: Instruction, window: Window) -> np.ndarray:

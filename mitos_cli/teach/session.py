@@ -530,7 +530,13 @@ class Session:
         close, the hint names the behavior that has it (`drive` has no rules of its own: it
         uses the behaviors that do)."""
         exc = unknown("rule label", label, labels, owner=b.name)
-        if exc.hint is None:
+        var = self.rulebase.variables.get(label)
+        if var is not None and var.terms:           # `frozen heading`: its terms, one by one
+            terms = [f"{label}.{t.name}" for t in var.terms]
+            shown = ", ".join(terms[:5]) + (", ..." if len(terms) > 5 else "")
+            exc.hint = (f"`{label}` is a variable: freeze its terms, `frozen {shown}` (or one "
+                        f"of them: `frozen {terms[0]}`)")
+        elif exc.hint is None:
             owners = [o.name for o in self.rulebase.behaviors
                       if o.name != b.name and any(r.label == label for r in o.rules)]
             own = "" if labels else f"`{b.name}` has no rules of its own; "
@@ -734,6 +740,7 @@ class Session:
             ins = instruction(c.words)
         except LessonError as exc:
             exc.span = c.span
+            exc.hint = self._output_said(c.words) or exc.hint
             raise
         rec = self._recording()
         compiled = self._driver(rec)
@@ -759,6 +766,19 @@ class Session:
                  f"{text.num(float(wanted[first]))} at {rec.time(rows[first]):g} s)")
         self._add_window(compiled, rec, rows[keep], [inputs[i] for i in keep],
                          [{ins.output: float(wanted[i])} for i in keep], line)
+
+    def _output_said(self, words: tuple[str, ...]) -> str | None:
+        """What to write when an `at` line names an output where an instruction goes, alone
+        or with one of its terms but no `is` (`at 13s steering`, `at 13s speed SLOW`)."""
+        var = self.rulebase.variables.get(words[0])
+        if var is None or var.role != "output" or len(words) > 2:
+            return None
+        names = [t.name for t in var.terms]
+        if len(words) == 2 and words[1] not in names:
+            return None
+        said = (f"`{var.name} is {words[1]}`" if len(words) == 2 else
+                f"`{var.name} is TERM` (`{var.name} is {names[0]}`)")
+        return f"say what `{var.name}` should be: {said} or `{var.name}=VALUE`"
 
     def use_advice(self, name: str) -> str:
         """How to make behavior ``name`` the active one now: `use NAME`, but while a behavior
@@ -1159,6 +1179,13 @@ def _not_its(name: str, span: Span | None, role: str, names: tuple[str, ...],
                            span=span, expected=f"{role}s " + ", ".join(names))
     error = unknown(f"{role} variable", name, names, span=span, cls=LessonError)
     assert isinstance(error, LessonError)
+    other = compiled.variables.get(name)
+    if error.hint is None and other is not None:    # an input as a target, or the reverse
+        error.hint = (f"`{name}` is an input: a target sets an output ({', '.join(names)}); the "
+                      "inputs are given before `->` (in `at`, the run gives them)"
+                      if role == "output" else
+                      f"`{name}` is an output: it goes after `->`, as a target "
+                      f"(`-> {name}=VALUE`)")
     return error
 
 

@@ -144,8 +144,16 @@ class Recording:
         rows = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9)
                               & (active | (np.arange(len(t)) == self._last)))
         if rows.size == 0:
+            before = t[:self._last + 1][t[:self._last + 1] < start]
+            after = t[:self._last + 1][t[:self._last + 1] > stop]
+            hint = None
+            if before.size and after.size:          # a window between two ticks
+                step = float(t[1] - t[0]) if len(t) > 1 else 0.0
+                hint = (f"the ticks of {whose} are {step:g} s apart: the nearest are at "
+                        f"{float(before[-1]):g} s and {float(after[0]):g} s (`at {start:g}s` "
+                        "alone takes the nearest tick)")
             raise LessonError(f"no recorded tick between {start:g} s and {stop:g} s",
-                              span=_between(*places))
+                              span=_between(*places), hint=hint)
         return rows
 
     def when(self, rows: np.ndarray) -> str:
