@@ -386,10 +386,55 @@ BOXES = (360.0, 440.0, -45.0, 5.0)
 def test_the_room_across_a_path_is_measured_on_the_robots_map():
     path = np.stack([np.arange(0.0, 800.0, 4.0), np.full(200, 25.0)], axis=1)
     width, middle = traffic.across(corridor_map(BOXES), path, np.array([50, 100]), 44.0)
-    # at x = 200 the corridor (wall to wall; each side at most 44), at x = 400 the room
-    # between the boxes and the wall, in whole cells as the map marches its beams
-    assert width.tolist() == pytest.approx([20 + 44, 40], abs=2.0)
+    # at x = 200 the corridor (wall to wall 20 + 44: room for two, not measured), at x = 400
+    # the room between the boxes and the wall, in whole cells as the map marches its beams
+    assert math.isinf(width[0]) and middle[0].tolist() == [200.0, 25.0]
+    assert width[1] == pytest.approx(40, abs=2.0)
     assert middle[1, 1] == pytest.approx(25.0, abs=1.0)
+
+
+def _marched(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
+             cap: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`.traffic.across` as it was first written: every place's four beams marched."""
+    along = np.gradient(path, axis=0)[places]
+    length = np.hypot(along[:, 0], along[:, 1])
+    ok = length > 1e-9
+    unit = np.zeros_like(along)
+    unit[ok] = along[ok] / length[ok, None]
+    left = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    at = path[places]
+    origins = np.concatenate([at - unit * (traffic.STEP / 4), at + unit * (traffic.STEP / 4)] * 2)
+    n = len(places)
+    sides = rmap.ranges(origins, np.concatenate([left, left, -left, -left]), cap)
+    to_left, to_right = np.minimum(sides[:n], sides[n:2 * n]), np.minimum(sides[2 * n:3 * n],
+                                                                           sides[3 * n:])
+    width = to_left + to_right
+    width[~ok] = np.inf
+    return width, at + left * ((to_left - to_right) / 2)[:, None]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 780), st.floats(-60, 40), st.floats(1, 40),
+                          st.floats(1, 40)), max_size=4),
+       st.floats(-40, 40), st.floats(-0.6, 0.6), st.floats(10, 80))
+def test_the_room_measured_where_something_is_near_is_the_room_every_beam_gives(boxes, y, slope,
+                                                                                cap):
+    """Places with nothing occupied near are not marched: every place's room under ``cap``
+    is the same to the bit as with every place's beams marched, and none is missed."""
+    rmap = corridor_map()
+    gx, gy = np.meshgrid(-10.0 + (np.arange(420) + 0.5) * 2.0, -60.0 + (np.arange(60) + 0.5) * 2.0)
+    for x0, y0, w, h in boxes:
+        inside = (gx >= x0) & (gx <= x0 + w) & (gy >= y0) & (gy <= y0 + h)
+        rmap.mark_cells(np.stack([inside.nonzero()[1], inside.nonzero()[0]], axis=1))
+    xs = np.arange(0.0, 800.0, 4.0)
+    path = np.stack([xs, y + slope * (xs - 400.0)], axis=1)
+    places = np.arange(0, 200, 3)
+    width, middle = traffic.across(rmap, path, places, cap)
+    full, centre = _marched(rmap, path, places, cap)
+    under = full < cap
+    assert (width < cap).tolist() == under.tolist()
+    assert width[under].tolist() == full[under].tolist()
+    assert middle[under].tolist() == centre[under].tolist()
 
 
 def test_head_on_where_boxes_leave_room_for_one_the_robot_with_them_on_its_side_waits():

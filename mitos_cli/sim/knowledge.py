@@ -494,6 +494,24 @@ class RobotMap:
             return True
         return False
 
+    def any_near(self, points: np.ndarray, reach: float) -> np.ndarray:
+        """``[P]``: whether any occupied cell meets the square of half side ``reach`` round
+        each of ``points [P, 2]`` (a cell more on every side: never ``False`` where one does).
+        Counted on a running sum over the squares' common window, four reads a square."""
+        res, (ox, oy) = self.grid.resolution, self.grid.origin
+        rows, cols = self.occupied.shape
+        c0 = np.clip(np.floor((points[:, 0] - reach - ox) / res).astype(np.int64) - 1, 0, cols)
+        r0 = np.clip(np.floor((points[:, 1] - reach - oy) / res).astype(np.int64) - 1, 0, rows)
+        c1 = np.clip(np.floor((points[:, 0] + reach - ox) / res).astype(np.int64) + 2, 0, cols)
+        r1 = np.clip(np.floor((points[:, 1] + reach - oy) / res).astype(np.int64) + 2, 0, rows)
+        a, b, e, f = int(r0.min()), int(r1.max()), int(c0.min()), int(c1.max())
+        if a >= b or e >= f:
+            return np.zeros(len(points), dtype=bool)
+        sums = np.zeros((b - a + 1, f - e + 1), dtype=np.int64)
+        np.cumsum(np.cumsum(self.occupied[a:b, e:f], axis=0), axis=1, out=sums[1:, 1:])
+        r0, r1, c0, c1 = r0 - a, r1 - a, c0 - e, c1 - e
+        return (sums[r1, c1] - sums[r0, c1] - sums[r1, c0] + sums[r0, c0]) > 0
+
     def ranges(self, origin: np.ndarray, dirs: np.ndarray, max_range: float) -> np.ndarray:
         """Ranges ``[B]`` this map predicts: each beam marched in half cells to the first
         occupied cell (``max_range`` when none)."""

@@ -237,25 +237,34 @@ def _left(a: Mate, b: Mate, p: np.ndarray) -> float:
 def across(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
            cap: float) -> tuple[np.ndarray, np.ndarray]:
     """The room across ``path [K, 2]`` at its ``places`` on ``rmap``, to either side at
-    right angles to the path (each side at most ``cap``): its width ``[P]`` (``inf`` where
-    the path has no direction: its route's end) and its middle ``[P, 2]``. Each side is the
-    nearer of two beams a quarter of a STEP before and after the place: between them they
-    cross every cell the path passes (a face seen edge on is a cell or two thick)."""
+    right angles to the path (each side at most ``cap``), where it is less than ``cap``:
+    its width ``[P]`` (``inf`` where it is ``cap`` or more, and where the path has no
+    direction: its route's end) and its middle ``[P, 2]``. Each side is the nearer of two
+    beams a quarter of a STEP before and after the place: between them they cross every
+    cell the path passes (a face seen edge on is a cell or two thick). Only places with
+    something occupied within half of ``cap`` (and the beams' slack) are measured: the room
+    elsewhere is ``cap`` or more."""
+    at = path[places]
+    width, middle = np.full(len(places), np.inf), at.copy()
     along = np.gradient(path, axis=0)[places]
     length = np.hypot(along[:, 0], along[:, 1])
-    ok = length > 1e-9
-    unit = np.zeros_like(along)
-    unit[ok] = along[ok] / length[ok, None]
+    slack = STEP / 4 + rmap.grid.resolution
+    go = ((length > 1e-9) & rmap.any_near(at, cap / 2 + slack)).nonzero()[0]
+    if not len(go):
+        return width, middle
+    unit = along[go] / length[go, None]
     left = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
-    at = path[places]
+    at = at[go]
     origins = np.concatenate([at - unit * (STEP / 4), at + unit * (STEP / 4)] * 2)
-    n = len(places)
+    n = len(go)
     sides = rmap.ranges(origins, np.concatenate([left, left, -left, -left]), cap)
     to_left = np.minimum(sides[:n], sides[n:2 * n])
     to_right = np.minimum(sides[2 * n:3 * n], sides[3 * n:])
-    width = to_left + to_right
-    width[~ok] = np.inf
-    return width, at + left * ((to_left - to_right) / 2)[:, None]
+    room = to_left + to_right
+    under = room < cap
+    width[go[under]] = room[under]
+    middle[go[under]] = (at + left * ((to_left - to_right) / 2)[:, None])[under]
+    return width, middle
 
 
 def _cosine(u: np.ndarray | None, v: np.ndarray | None) -> float:

@@ -13,6 +13,7 @@ state is the replay of the changes not undone.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import errno
 import json
@@ -304,6 +305,15 @@ def _append_line(path: Path, data: bytes) -> None:
 
 #: the sessions this process holds (their lock files stay open until it exits)
 _HELD: dict[Path, object] = {}
+
+
+@atexit.register
+def _release() -> None:
+    """Close the lock files still held as the process ends (the system would release their
+    locks all the same; a file left to the interpreter's teardown is reported unclosed)."""
+    for fh in _HELD.values():
+        fh.close()                               # type: ignore[attr-defined]
+    _HELD.clear()
 
 
 def _lock(directory: Path) -> None:
