@@ -1010,6 +1010,11 @@ def test_a_comma_between_values_is_named_and_a_hedge_past_the_scale_is_noted(rul
         "note: `steering is very RB` lies past RB")
     assert say(s, out, "correct road=78 size=45 position=4 -> steering is very LM").startswith(
         "example 3:")                                       # 40: inside the scale, no note
+    # the middle term: a hedge moves a target away from it, so `very ST` is ST (said so)
+    assert say(s, out, "correct road=78 size=45 position=4 -> steering is very ST") == (
+        "note: `steering is very ST` is ST's own value, steering=90: a hedge moves a target "
+        "away from the middle of the steering scale, where ST stands\n"
+        "example 4: road=78 size=45 position=4 -> steering=90   (now steering=65.41)")
 
 
 def test_not_adapted_names_the_frozen_input_terms_too(rules):

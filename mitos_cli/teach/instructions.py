@@ -99,6 +99,13 @@ def past_the_end(var: Variable, term: str, hedges: tuple[str, ...]) -> str | Non
     return scale.names[last] if u > last + 1e-9 else None
 
 
+def at_the_middle(var: Variable, term: str) -> bool:
+    """Whether ``term`` stands at the middle of ``var``'s scale, which a hedge moves a target
+    away from: ``very ST`` is ST's own value."""
+    scale = scale_of(var)
+    return abs(float(scale.steps(np.array(var.term(term).center))) - scale.centre) < 1e-9
+
+
 def not_a_target_hedge(hedge: str, term: str, span: Span | None = None) -> LessonError:
     """The error for a hedge of a rule's condition in a target (`seldom LB`), at ``span``."""
     return LessonError(f"`{hedge} {term}` has no meaning for a target value", span=span,

@@ -700,7 +700,7 @@ class Session:
 
     def _said(self, said: tuple[cmd.Said, ...], compiled: CompiledRuleBase) -> tuple[cmd.Assign, ...]:
         """``steering is very LM`` -> ``steering=40`` (the hedged term's value)."""
-        from .instructions import HEDGE_STEPS, hedged, not_a_target_hedge, past_the_end
+        from .instructions import HEDGE_STEPS, at_the_middle, hedged, not_a_target_hedge, past_the_end
 
         out = []
         for t in said:
@@ -716,11 +716,15 @@ class Session:
                     raise not_a_target_hedge(h, t.term, t.span and t.span.naming(h))
             value = hedged(var, t.term, t.hedges)
             end = past_the_end(var, t.term, t.hedges)
+            words = " ".join(t.hedges + (t.term,))
             if end is not None:
-                words = " ".join(t.hedges + (t.term,))
                 self.out(f"note: `{t.name} is {words}` lies past {end}, the end of the "
                          f"{t.name} scale: the target is {end}'s value, "
                          f"{t.name}={format_number(value)}")
+            elif t.hedges and at_the_middle(var, t.term):
+                self.out(f"note: `{t.name} is {words}` is {t.term}'s own value, "
+                         f"{t.name}={format_number(value)}: a hedge moves a target away from "
+                         f"the middle of the {t.name} scale, where {t.term} stands")
             out.append(cmd.Assign(t.name, value, t.span))
         return tuple(out)
 
