@@ -1729,6 +1729,8 @@ def world_not_found(name: str | Path, where: Path) -> UnknownWorld:
     hint = f"did you mean `{close}`?" if close else None
     if given.suffix or len(where.parts) > 1:      # a path: a file beside it first
         hint = _beside(where, given, maybe_packaged) or hint
+    elif close is None:                           # `tiny` for the `tiny.yaml` beside it
+        hint = _beside(where, given, [])
     same_name = given.name if given.name.endswith(".yaml") else given.name + ".yaml"
     if len(given.parts) > 1 and same_name in packaged:
         hint = (f"there is no `{given}`; the packaged world of that name is "
