@@ -240,17 +240,19 @@ class NumberMutator(Mutator):
             return text
         for _ in range(rng.choice((1, 1, 2, 3))):
             i = rng.choice(nums)
-            toks[i] = self.pushed(rng, float(toks[i]))
+            if NUMBER.fullmatch(toks[i]):         # (not one pushed already to `0x1F`)
+                toks[i] = self.pushed(rng, float(toks[i]))
         return "".join(toks)
 
     @staticmethod
     def pushed(rng: random.Random, x: float) -> str:
         choice = rng.randrange(9)
-        if choice == 0:
+        if choice == 0 or not math.isfinite(x):
             return rng.choice(NUMBERS)
-        y = (x * rng.uniform(0.5, 1.5), -x, 0.0, x * 10, x / 10, x + 1e-9, x - 1e-9,
-             float(round(x * rng.uniform(0.8, 1.2))))[choice - 1]
-        return repr(y)
+        pushed = (lambda: x * rng.uniform(0.5, 1.5), lambda: -x, lambda: 0.0, lambda: x * 10,
+                  lambda: x / 10, lambda: x + 1e-9, lambda: x - 1e-9,
+                  lambda: float(round(x * rng.uniform(0.8, 1.2))))
+        return repr(pushed[choice - 1]())
 
 
 def yaml_mutator(words: tuple[str, ...]) -> Mutator:
@@ -431,7 +433,8 @@ def long_run(argv: list[str]) -> str:
         return ""
     given = dict(zip(argv, argv[1:]))
     runs = given.get("--runs", "20" if argv[0] == "compare" else "1")
-    total = max(int(runs), 1) if runs.isdigit() else 1
+    n = int(runs) if runs.isascii() and runs.isdigit() and len(runs) <= 6 else 1
+    total = n if 1 <= n <= 100_000 else 1      # (past 100,000, `--runs` is refused)
     if argv[0] == "compare":
         for flag, default in (("--and", 4), ("--or", 1), ("--inference", 1), ("--planner", 2)):
             total *= len(given[flag].split(",")) if flag in given else default
