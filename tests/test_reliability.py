@@ -1180,8 +1180,8 @@ def _fleet(n: int) -> str:
 
 
 def test_a_fleet_loads_in_time_near_linear_in_its_robots():
-    """Every two robots' starts were measured box against box (night 24's fuzzing: 400 robots
-    took 4.1 to 4.6 CPU s to load, 800 took 16); only robots whose bodies' circles meet are
+    """Every two robots' starts were measured box against box (night 24's campaign, by hand: 400
+    robots took 4.1 to 4.6 CPU s to load, 800 took 16); only robots whose bodies' circles meet are
     measured now. What is left of the pairs is the goals' check, microseconds each."""
     from mitos_cli.sim.worldfile import parse_world
 
