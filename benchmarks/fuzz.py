@@ -224,6 +224,37 @@ class Mutator:
            nesting, long_line, lines)
 
 
+#: a number as written in YAML (a token of :data:`TOKEN` that float() reads)
+NUMBER = re.compile(r"[-+]?\d+(\.\d*)?([eE][-+]?\d+)?")
+
+
+@dataclass
+class NumberMutator(Mutator):
+    """Numbers only, each pushed near or far: most inputs still load and run, so that what
+    reads them later (a simulation) gets odd figures, not only the reader's refusals."""
+
+    def __call__(self, rng: random.Random, text: str) -> str:
+        toks = tokens(text)
+        nums = [i for i, t in enumerate(toks) if NUMBER.fullmatch(t)]
+        if not nums:
+            return text
+        for _ in range(rng.choice((1, 1, 2, 3))):
+            i = rng.choice(nums)
+            if NUMBER.fullmatch(toks[i]):         # (not one pushed already to `0x1F`)
+                toks[i] = self.pushed(rng, float(toks[i]))
+        return "".join(toks)
+
+    @staticmethod
+    def pushed(rng: random.Random, x: float) -> str:
+        choice = rng.randrange(9)
+        if choice == 0 or not math.isfinite(x):
+            return rng.choice(NUMBERS)
+        pushed = (lambda: x * rng.uniform(0.5, 1.5), lambda: -x, lambda: 0.0, lambda: x * 10,
+                  lambda: x / 10, lambda: x + 1e-9, lambda: x - 1e-9,
+                  lambda: float(round(x * rng.uniform(0.8, 1.2))))
+        return repr(pushed[choice - 1]())
+
+
 def yaml_mutator(words: tuple[str, ...]) -> Mutator:
     """YAML: the text mutators plus anchors, aliases, merge keys, tags and duplicate keys."""
     def alias_bomb(depth: int) -> str:
@@ -366,15 +397,67 @@ def refusal_on_stdout(out: str) -> tuple[str, str]:
     return ("refused+pos", "") if POSITIONED.match(line) else ("refused", line[:60])
 
 
+class _NonFiniteJSON(ValueError):
+    pass
+
+
+def _no_constant(name: str) -> float:
+    raise _NonFiniteJSON(name)
+
+
+def finite_outcome(code: int, err: str, out: str) -> tuple[str, str]:
+    """:func:`cli_outcome`, and for a run that printed JSON: a `NaN` or `Infinity` in it is
+    non-finite (no option of `simulate` or `compare` asks for one)."""
+    outcome = cli_outcome(code, err, out)
+    if outcome[0] == "loaded" and out.lstrip().startswith(("{", "[")):
+        try:
+            json.loads(out, parse_constant=_no_constant)
+        except _NonFiniteJSON as exc:
+            return "nonfinite", f"{exc} in --json"
+        except ValueError:
+            return "foreign", "--json printed what is not JSON"
+    return outcome
+
+
+#: runs (`--runs` times the worlds and choices) past which a mutated `simulate` or `compare`
+#: command line is not run: a long run the user asked for, not a hang
+MOST_RUNS = 12
+
+
+def long_run(argv: list[str]) -> str:
+    """What a `simulate` or `compare` command line asks for that is too long for a campaign
+    ('' if nothing): more than :data:`MOST_RUNS` runs (`compare`: runs times worlds times
+    choices, with its defaults of 20 runs, four T-norms and two planners), or a live view
+    paced in real time."""
+    if argv[:1] not in (["simulate"], ["compare"]):
+        return ""
+    given = dict(zip(argv, argv[1:]))
+    runs = given.get("--runs", "20" if argv[0] == "compare" else "1")
+    n = int(runs) if runs.isascii() and runs.isdigit() and len(runs) <= 6 else 1
+    total = n if 1 <= n <= 100_000 else 1      # (past 100,000, `--runs` is refused)
+    if argv[0] == "compare":
+        for flag, default in (("--and", 4), ("--or", 1), ("--inference", 1), ("--planner", 2)):
+            total *= len(given[flag].split(",")) if flag in given else default
+        total *= max(1, sum(1 for a in argv[1:] if a.endswith(".yaml")))
+    if total > MOST_RUNS:
+        return f"{total} runs"
+    if ("--live" in argv or "--speed" in argv) and given.get("--speed") != "0":
+        return "a live view in real time"
+    return ""
+
+
 def via_cli(kind: Kind, how: str, limit: float) -> Callable:
     """``kind.run`` replaced by the ``mitos`` command that reads the input."""
     def run(data, work: Path):
         argv = kind.argv(data, work)
         if not possible(argv):
             return "refused", "argument list too long (the system refuses to run it)"
+        asked = long_run(argv)
+        if asked:
+            return "refused", f"not run: {asked} (a long run the user asked for)"
         if how == "subprocess":
-            return cli_outcome(*cli_subprocess(argv, work, timeout=3 * limit + 10))
-        return cli_outcome(*cli_in_process(argv, work))
+            return finite_outcome(*cli_subprocess(argv, work, timeout=3 * limit + 10))
+        return finite_outcome(*cli_in_process(argv, work))
     return run
 
 
@@ -484,6 +567,8 @@ class Kinds:
         if fresh:
             shutil.copytree(ROOT / "rulebases", rb_dir)
             shutil.copytree(ROOT / "worlds", work / "worlds")
+            # the world of two robots that the lessons in words simulate
+            shutil.copyfile(ROOT / "tests" / "data" / "fleet_tiny.yaml", work / "fleet.yaml")
         self.rb_dir = rb_dir
         self._termsets: dict[str, object] = {}
         self._session = None
@@ -648,6 +733,36 @@ class Kinds:
             return "refused", "argument list too long (the system refuses to run it)"
         return cli_outcome(*cli_in_process(argv, work))
 
+    # -- fleets, lessons in words, simulate and compare (2026-12-07, night 24) -----------------
+    def argv_fleet(self, text: str, work: Path) -> list[str]:
+        """`mitos simulate WORLD --json` of a mutated world of several robots (or moving
+        obstacles): read, checked and driven; what it prints must be finite."""
+        return ["simulate", self._file(work, "fleet.yaml", text), "--json"]
+
+    def run_fleet(self, text: str, work: Path) -> tuple[str, str]:
+        return finite_outcome(*cli_in_process(self.argv_fleet(text, work), work))
+
+    #: the files a `simulate` or `compare` command line may name, copied into each input's
+    #: own directory
+    RUN_FILES = {"tiny.yaml": "tests/data/tiny.yaml", "fleet.yaml": "tests/data/fleet_tiny.yaml",
+                 "mitos.rules": "rulebases/mitos.rules",
+                 "mitos.terms.yaml": "rulebases/mitos.terms.yaml",
+                 "drive.terms.yaml": "rulebases/drive.terms.yaml"}
+
+    def argv_runs(self, text: str, work: Path) -> list[str]:
+        for name, source in self.RUN_FILES.items():
+            shutil.copyfile(ROOT / source, work / name)
+        return command_line(text)
+
+    def run_runs(self, text: str, work: Path) -> tuple[str, str]:
+        argv = self.argv_runs(text, work)
+        if not possible(argv):
+            return "refused", "argument list too long (the system refuses to run it)"
+        asked = long_run(argv)
+        if asked:
+            return "refused", f"not run: {asked} (a long run the user asked for)"
+        return finite_outcome(*cli_in_process(argv, work))
+
     # -- seeds --------------------------------------------------------------------------------
     def journal_seeds(self) -> list[tuple[str, str]]:
         from mitos_cli.teach.journal import Journal
@@ -743,6 +858,65 @@ class Kinds:
                         "tipper.fis", "small.lesson", "fll", "fcl", "fis", "rules", "c",
                         "python", "matlab", "fuzzylite", "nan", "skip", "default", "error",
                         "x" * 300 + ".rules", "--help", "-h", "--version"))
+        fleets = [(f"{name}", text) for name, text in _shipped(
+            "tests/data/fleet_tiny.yaml", "tests/data/crossroads4.yaml",
+            "tests/data/crossroads_carts.yaml", "tests/data/traffic/narrow_pass.yaml",
+            "tests/data/traffic/merge.yaml", "worlds/multirobot.yaml", "worlds/moving.yaml")]
+        fleet_mut = yaml_mutator(("robots", "robot", "name", "q_init", "q_goal", "x", "y",
+                                  "heading", "tolerance", "give_way", "footprint", "length",
+                                  "width", "wheelbase", "max_speed", "acceleration",
+                                  "safety_margin", "steering", "behavior", "obstacles",
+                                  "shape", "circle", "rectangle", "at", "radius", "velocity",
+                                  "waypoints", "speed", "mode", "ping-pong", "loop",
+                                  "randomise", "dx", "dy", "sensor_noise", "corridors",
+                                  "points", "time_limit", "dt", "substeps", "seed", "oncoming",
+                                  "all robots", "robot 2", "true", "false"))
+        words_lessons = [
+            ("fleet.lesson", "use drive\nsimulate fleet.yaml seed 2 robot oncoming\n"
+             "at 1s to 2s steering is very LS\nat 4s to 5s speed is SLOW\n"
+             "frozen heading.AHEAD, steering.LS\nunfrozen steering.ST\n"
+             "adapt epochs 3 rate 0.5\nshow terms\nat 6s to 7s turn harder\nat 6s to 7s slow down\n"
+             "at 7s to 8s make a wider turn\nshow history\nsave out/taught.rules\n"),
+            ("words.lesson", "correct road=78 size=45 position=4 -> steering is very LM and "
+             "speed is SLOW\ncorrect road=20 size=10 position=-8 -> steering=40 speed=10\n"
+             "frozen r1, r2\nfrozen steering.RS\nadapt epochs 2\nundo\nunfrozen steering.RS\n"
+             "show examples\nbehavior turn:\n  if road is WIDE then steering is RS\n"
+             "  frozen r1\nend\nuse avoid_obstacle\nsave\n"),
+            ("robot.lesson", "use drive\nsimulate fleet.yaml robot \"robot\"\n"
+             "at 1.5s steering=60\nat 3s to 3.5s turn less\nat 8s speed up\n"
+             "adapt epochs 2 unconstrained\nunfrozen heading.AHEAD\nshow terms\n")]
+        lesson_mut = Mutator(RULE_WORDS + (
+            "correct", "eval", "adapt", "epochs", "rate", "undo", "at", "s", "to", "simulate",
+            "show", "save", "frozen", "unfrozen", "heading.AHEAD", "steering.LS", "speed.SLOW",
+            ".", "robot", "seed", "oncoming", '"', "make a wider turn", "turn harder",
+            "turn less", "slow down", "speed up", "and", "very", "somewhat", "is", "LM", "ST",
+            "terms", "history", "examples", "unconstrained", "1e400s", "-1s", "nan"),
+            RULE_NEST[:3])
+        runs_lines = [(f"runs{i}", line) for i, line in enumerate((
+            "simulate tiny.yaml --json --seed 3",
+            "simulate fleet.yaml --runs 3 -j 1 --seed 2 --json",
+            "simulate tiny.yaml --randomise --seed 4 -o out.csv",
+            "simulate fleet.yaml --trace --every 50 --planner dwa",
+            "simulate tiny.yaml -b drive --require success --planner potential_field",
+            "simulate fleet.yaml -r mitos.rules --live --speed 0",
+            "simulate tiny.yaml --plot run.png --seed 1",
+            "compare tiny.yaml --and min,product --planner fuzzy --runs 2 -j 1 -o study "
+            "--no-plots",
+            "compare fleet.yaml --planner fuzzy,dwa --and min --runs 1 -j 1 -o s2 --no-plots "
+            "--json",
+            "compare tiny.yaml --and product --or dual --inference mamdani,weighted_average "
+            "--planner fuzzy --runs 1 -j 1 --no-plots -o s3",
+            "compare tiny.yaml --and min --planner fuzzy --runs 2 -j 1 --no-plots -o study "
+            "--resume --seed 7 -b drive"))]
+        runs_mut = Mutator((
+            "simulate", "compare", "--json", "--seed", "--runs", "--randomise", "-o", "--out",
+            "--trace", "--every", "--plot", "--live", "--speed", "--require", "success",
+            "--workers", "-j", "--planner", "fuzzy", "dwa", "potential_field", "--rulebase",
+            "-r", "--behavior", "-b", "drive", "--and", "--or", "--inference", "min",
+            "product", "lukasiewicz", "einstein", "dual", "mamdani", "tsukamoto",
+            "weighted_sum", "--resume", "--plots", "--no-plots", "--scheduler", "--executor",
+            "local", "tiny.yaml", "fleet.yaml", "mitos.rules", "study", "out.csv", "run.png",
+            ",", "-", "--", "0", "1", "nan", "x" * 300 + ".yaml", "--help", "-h"))
         k = self
         return [
             Kind("rule files", rules, rule_mut, k.run_rules, ".rules", k.argv_rules),
@@ -759,6 +933,14 @@ class Kinds:
             Kind("teach journals", self.journal_seeds(), jmut, k.run_journal, ".jsonl",
                  k.argv_journal),
             Kind("CLI arguments", args, amut, k.run_args, ".args", k.argv_args),
+            # night 24: appended, so the kinds above make the same inputs as before
+            Kind("fleet worlds", fleets, fleet_mut, k.run_fleet, ".yaml", k.argv_fleet),
+            Kind("lessons in words", words_lessons, lesson_mut, k.run_lesson, ".lesson",
+                 k.argv_lesson),
+            Kind("simulate and compare arguments", runs_lines, runs_mut, k.run_runs, ".args",
+                 k.argv_runs),
+            Kind("fleet numbers", fleets, NumberMutator(()), k.run_fleet, ".yaml",
+                 k.argv_fleet),
         ]
 
     def fll_seeds(self) -> list[tuple[str, str]]:
@@ -921,6 +1103,12 @@ def _allowance(kind: Kind, i: int, seed: int) -> float:
     return len(make_input(kind, i, seed)[1]) / 1024 * PER_KB
 
 
+#: kinds whose inputs always go through the command line's ``main`` (a command line, or a
+#: world that only ``simulate`` reads and drives): ``--via cli`` changes nothing for them
+THROUGH_MAIN = ("CLI arguments", "fleet worlds", "simulate and compare arguments",
+                "fleet numbers")
+
+
 def routed(kinds: list[Kind], via: str, limit: float) -> list[Kind]:
     """The kinds as ``--via`` runs them: ``reader`` calls the library's readers, ``cli`` the
     command line's ``main`` in this process, ``subprocess`` ``python -m mitos_cli``. A kind no
@@ -928,7 +1116,7 @@ def routed(kinds: list[Kind], via: str, limit: float) -> list[Kind]:
     if via == "reader":
         return kinds
     for kind in kinds:
-        if kind.argv is not None and (via == "subprocess" or kind.name != "CLI arguments"):
+        if kind.argv is not None and (via == "subprocess" or kind.name not in THROUGH_MAIN):
             kind.run = via_cli(kind, via, limit)
     return kinds
 
@@ -960,7 +1148,8 @@ def share_rule_base(rb_dir: Path) -> None:
 #: 0.2 CPU s of real work) and a command line runs a whole command (about 30 ms), so they get
 #: fewer; batch CSVs and journals (about 1 and 3 ms) more
 SHARE = {"lessons": 1 / 12, "CLI arguments": 1 / 3, "eval --batch CSV": 1.4,
-         "teach journals": 1.4}
+         "teach journals": 1.4, "fleet worlds": 1 / 6, "lessons in words": 1 / 6,
+         "simulate and compare arguments": 1 / 6, "fleet numbers": 1 / 6}
 
 
 def count_of(kind: Kind, per_format: int) -> int:
@@ -970,7 +1159,13 @@ def count_of(kind: Kind, per_format: int) -> int:
 def _worker(conn, kind_index: int, start: int, stop: int, step: int, seed: int,
             limit: float, slow: float, work: Path, via: str) -> None:
     """Runs inputs ``start, start + step, ... < stop`` of one kind, announcing each first."""
+    import multiprocessing as mp
+
     resource.setrlimit(resource.RLIMIT_AS, (4 << 30, resource.RLIM_INFINITY))
+    # the worker is daemonic so that it ends with the campaign; but `compare`, and `simulate
+    # --runs` without `-j 1`, start a process pool, which a daemonic process may not (an
+    # AssertionError no user meets): the pool's workers end with this one (sim/runs.py)
+    mp.current_process().daemon = False
     os.chdir(work)                      # teaching writes `.mitos/` and saves here
     kinds = Kinds(work, fresh=False)
     share_rule_base(kinds.rb_dir)

@@ -68,6 +68,11 @@ def nearby_name(path: str | Path, suffixes: tuple[str, ...] = RULE_SUFFIXES,
                  and p.name != given and _there(p)]
     except OSError:                 # no such directory: only ``also`` may be meant
         names = []
+    # the name without its extension (`tiny` for `tiny.yaml`, `my` for `my.rules`): too far
+    # from it for closest_file, and said "not found" with no word of the file beside it
+    whole = sorted(n for n in names if any(n.lower() == given.lower() + s for s in suffixes))
+    if whole:
+        return whole[0]
     return closest_file(given, [*names, *(n for n in also if n != given)])
 
 

@@ -511,6 +511,36 @@ def test_a_file_named_with_a_trailing_slash_is_a_usage_error(args, tmp_path, mon
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_file_named_without_its_extension_gets_the_file_as_its_did_you_mean(
+        tmp_path, capsys, monkeypatch):
+    """`mitos simulate tiny` beside `tiny.yaml` (night 24's fuzzing) said "world file `tiny`
+    not found" and listed the packaged worlds, with no word of the file there; `mitos check
+    my` beside `my.rules`, and `--lesson a` beside `a.lesson`, said only "not found": the
+    name is too far from `tiny.yaml` for the closest-name match."""
+    root = Path(__file__).parents[1]
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tiny.yaml").write_text((root / "tests" / "data" / "tiny.yaml").read_text())
+    (tmp_path / "my.rules").write_text("")
+    (tmp_path / "a.lesson").write_text("quit\n")
+    assert run_main(capsys, "tiny") == (1, (
+        "world error: world file `tiny` not found\n"
+        "expected one of the packaged worlds: corridor, detour, figure4, intersection, moving, "
+        "multirobot, office, slalom\n"
+        "hint: did you mean `tiny.yaml`?\n"))
+    with pytest.raises(SystemExit) as info:
+        main(["check", "my"])
+    assert (info.value.code, capsys.readouterr().err) == (1, (
+        "rule base error: rule file `my` not found\nhint: did you mean `my.rules`?\n"))
+    with pytest.raises(SystemExit) as info:
+        main(["teach", str(root / "rulebases" / "mitos.rules"), "--lesson", "a",
+              "--save-as", "o.rules"])
+    assert (info.value.code, capsys.readouterr().err) == (1, (
+        "lesson error: lesson `a` not found\n"
+        "expected a lesson file, or a packaged lesson: wider-turn\n"
+        "hint: did you mean `a.lesson`?\n"))
+    assert run_main(capsys, "slalm")[1].endswith("hint: did you mean `slalom`?\n")
+
+
 def test_a_world_that_is_a_link_to_nothing_is_said_so(tmp_path, capsys, monkeypatch):
     """A loop or a dangling link was "world file `loop1.yaml` not found", with "did you mean
     `loop1.yaml`?"."""

@@ -5,6 +5,8 @@ robot, quotes what was written, and says where a key in the wrong block belongs
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mitos_cli.errors import WorldError
 from mitos_cli.sim.worldfile import parse_world
@@ -387,3 +389,53 @@ def test_a_misspelt_heading_beside_q_init_is_offered_without_a_value_it_lacks():
     text = error(world("    headng: 180\n"))
     assert ("hint: did you mean `heading`? `heading` is the start's: write it in `q_init`, as "
             "`q_init: {x: ..., y: ..., heading: ...}`") in text
+
+
+def _open_fleet(starts: list[tuple[float, float, float]], size: tuple[float, float]) -> str:
+    """A wide corridor, the first robot far off, and one robot of ``size`` (length, width)
+    at each of ``starts`` (x, y, heading), each to a goal of its own far from every start."""
+    length, width = size
+    rows = "".join(f"  - {{name: r{i}, q_init: {{x: {x!r}, y: {y!r}, heading: {h!r}}}, "
+                   f"q_goal: {{x: {1000 + 80 * i}, y: -60}}}}\n"
+                   for i, (x, y, h) in enumerate(starts))
+    end = 1100 + 80 * len(starts)
+    return (f"name: t\ndt: 0.05\ntime_limit: 10\nrobot:\n  model: tricycle\n  wheelbase: 16\n"
+            f"  footprint: {{length: {length!r}, width: {width!r}}}\n"
+            f"q_init: {{x: 30, y: -60}}\nq_goal: {{x: {end - 40}, y: 60}}\n"
+            f"robots:\n{rows}map:\n  corridors:\n    - points: [[0, 0], [{end}, 0]]\n"
+            f"      width: 240\n")
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.floats(200, 320), st.floats(-50, 50), st.floats(-180, 180)),
+                min_size=2, max_size=6),
+       st.tuples(st.floats(18, 40), st.floats(16, 18)))
+def test_overlapping_starts_are_found_as_measuring_every_pair_finds_them(starts, size):
+    """The starts' check measures only robots whose bodies' circles meet (a fleet of 400
+    took 4.6 CPU s, every pair measured): the first pair that touches or overlaps, in the
+    file's order, is the one measuring every pair finds."""
+    import math
+
+    import numpy as np
+
+    from mitos_cli.sim.geometry import box_polygon_distance, rect_corners
+
+    length, width = size
+    found = None
+    for i, (x, y, h) in enumerate(starts):
+        c, s = math.cos(math.radians(h)), math.sin(math.radians(h))
+        for j, (x2, y2, h2) in enumerate(starts[:i]):
+            corners = rect_corners(x2, y2, math.radians(h2), length, width)
+            local = (corners - np.array([x, y])) @ np.array([[c, -s], [s, c]])
+            if box_polygon_distance(length / 2, width / 2, local[None])[0] <= 0.0:
+                found = (i, j)
+                break
+        if found:
+            break
+    text = _open_fleet(starts, size)
+    if found is None:
+        parse_world(text, "w.yaml")
+        return
+    said = error(text)
+    i, j = found
+    assert f"at the start (q_init) of `r{i}`" in said and f"robot `r{j}`'s at its start" in said

@@ -264,6 +264,8 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
         mark = (exc.context_mark if at_start else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
         problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
+        if mark is not None and exc.problem == _TAB and _TRAILING.match(text, mark.index):
+            problem, expected = _TRAILING_TAB
         hint = glued_hint(text, mark.line + 1) if mark is not None else None
         raise error(f"invalid YAML: {problem}", span=span, expected=expected, hint=hint) \
             from None
@@ -332,9 +334,19 @@ def unclosed_flow(exc: yaml.MarkedYAMLError, text: str, path: str | None,
         from None
 
 
+#: PyYAML's words for a tab where a token would start
+_TAB = "found character '\\t' that cannot start any token"
+#: blanks to the line's end (or to a comment) from a tab on
+_TRAILING = re.compile(r"\t[ \t]*(?:#[^\n]*)?(?:\r?\n|\r|$)")
+#: a tab after the last thing on a line: YAML takes it there, as any blank, but PyYAML does
+#: not, and "a tab, which YAML does not take as indentation" sent users looking at the indent
+_TRAILING_TAB = ("a tab at the end of the line, after what it holds (the YAML reader takes "
+                 "no tab there, though a space is fine)", "nothing after it on the line: delete "
+                 "the tab, or make it a space")
+
 #: PyYAML's words for the mistakes people make most, and what YAML expected there
 _WORDS = {
-    "found character '\\t' that cannot start any token":
+    _TAB:
         ("a tab, which YAML does not take as indentation or to start a value",
          "spaces: YAML indents with spaces only"),
     "mapping values are not allowed here":
