@@ -413,6 +413,16 @@ def _marched(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
     return width, at + left * ((to_left - to_right) / 2)[:, None]
 
 
+@settings(max_examples=100, deadline=None)
+@given(st.integers(2, 60), st.data())
+def test_a_paths_direction_at_some_places_is_numpys_gradient_there(n, data):
+    """:func:`.traffic._along` works the gradient out only where it is needed, to the bit."""
+    coords = st.floats(-1e4, 1e4, allow_nan=False)
+    path = np.array(data.draw(st.lists(st.tuples(coords, coords), min_size=n, max_size=n)))
+    places = np.array(sorted(data.draw(st.sets(st.integers(0, n - 1), min_size=1))))
+    assert traffic._along(path, places).tolist() == np.gradient(path, axis=0)[places].tolist()
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.floats(0, 780), st.floats(-60, 40), st.floats(1, 40),
                           st.floats(1, 40)), max_size=4),

@@ -308,12 +308,14 @@ class RobotMap:
     _last_near: tuple | None = field(default=None, repr=False)     # see near()
     _decoded: tuple | None = field(default=None, repr=False)   # see _marks_decoded()
     _origin: np.ndarray = field(init=False, repr=False)        # the grid's origin, [2]
+    _size: np.ndarray = field(init=False, repr=False)          # its columns and rows, [2]
     faces: np.ndarray = field(default_factory=lambda: _NO_FACES, repr=False)
     # [F, 2] squares flush with the walls it is given, for the brake (wall_faces), by x
     _faces_x: np.ndarray = field(init=False, repr=False)      # their x, [F] (contiguous)
 
     def __post_init__(self) -> None:
         self._origin = np.array(self.grid.origin, float)
+        self._size = np.array(self.occupied.shape[::-1], np.int64)
         self._faces_x = np.ascontiguousarray(self.faces[:, 0])
 
     @classmethod
@@ -497,19 +499,20 @@ class RobotMap:
     def any_near(self, points: np.ndarray, reach: float) -> np.ndarray:
         """``[P]``: whether any occupied cell meets the square of half side ``reach`` round
         each of ``points [P, 2]`` (a cell more on every side: never ``False`` where one does).
-        Counted on a running sum over the squares' common window, four reads a square."""
-        res, (ox, oy) = self.grid.resolution, self.grid.origin
-        rows, cols = self.occupied.shape
-        c0 = np.clip(np.floor((points[:, 0] - reach - ox) / res).astype(np.int64) - 1, 0, cols)
-        r0 = np.clip(np.floor((points[:, 1] - reach - oy) / res).astype(np.int64) - 1, 0, rows)
-        c1 = np.clip(np.floor((points[:, 0] + reach - ox) / res).astype(np.int64) + 2, 0, cols)
-        r1 = np.clip(np.floor((points[:, 1] + reach - oy) / res).astype(np.int64) + 2, 0, rows)
-        a, b, e, f = int(r0.min()), int(r1.max()), int(c0.min()), int(c1.max())
-        if a >= b or e >= f:
+        Counted on a running sum over the squares' common window, four reads a square; a
+        window with nothing occupied (a route down the middle of a corridor) is all ``False``."""
+        res, size = self.grid.resolution, self._size
+        lo = np.minimum(np.maximum(np.floor((points - reach - self._origin) / res)
+                                   .astype(np.int64) - 1, 0), size)       # [P, 2]: col, row
+        hi = np.minimum(np.maximum(np.floor((points + reach - self._origin) / res)
+                                   .astype(np.int64) + 2, 0), size)
+        (e, a), (f, b) = lo.min(axis=0).tolist(), hi.max(axis=0).tolist()
+        window = self.occupied[a:b, e:f]
+        if not window.any():
             return np.zeros(len(points), dtype=bool)
         sums = np.zeros((b - a + 1, f - e + 1), dtype=np.int64)
-        np.cumsum(np.cumsum(self.occupied[a:b, e:f], axis=0), axis=1, out=sums[1:, 1:])
-        r0, r1, c0, c1 = r0 - a, r1 - a, c0 - e, c1 - e
+        np.cumsum(np.cumsum(window, axis=0), axis=1, out=sums[1:, 1:])
+        c0, r0, c1, r1 = lo[:, 0] - e, lo[:, 1] - a, hi[:, 0] - e, hi[:, 1] - a
         return (sums[r1, c1] - sums[r0, c1] - sums[r1, c0] + sums[r0, c0]) > 0
 
     def ranges(self, origin: np.ndarray, dirs: np.ndarray, max_range: float) -> np.ndarray:

@@ -246,13 +246,16 @@ def across(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
     elsewhere is ``cap`` or more."""
     at = path[places]
     width, middle = np.full(len(places), np.inf), at.copy()
-    along = np.gradient(path, axis=0)[places]
-    length = np.hypot(along[:, 0], along[:, 1])
-    slack = STEP / 4 + rmap.grid.resolution
-    go = ((length > 1e-9) & rmap.any_near(at, cap / 2 + slack)).nonzero()[0]
+    go = rmap.any_near(at, _reach(rmap, cap)).nonzero()[0]
     if not len(go):
         return width, middle
-    unit = along[go] / length[go, None]
+    along = _along(path, places[go])
+    length = np.hypot(along[:, 0], along[:, 1])
+    ok = length > 1e-9
+    go, along, length = go[ok], along[ok], length[ok]
+    if not len(go):
+        return width, middle
+    unit = along / length[:, None]
     left = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
     at = at[go]
     origins = np.concatenate([at - unit * (STEP / 4), at + unit * (STEP / 4)] * 2)
@@ -265,6 +268,23 @@ def across(rmap: RobotMap, path: np.ndarray, places: np.ndarray,
     width[go[under]] = room[under]
     middle[go[under]] = (at + left * ((to_left - to_right) / 2)[:, None])[under]
     return width, middle
+
+
+def _reach(rmap: RobotMap, cap: float) -> float:
+    """How near a place something occupied must lie on ``rmap`` for the room across it to be
+    less than ``cap``: half of it, and the beams' slack (a quarter STEP to a beam's origin,
+    a cell to the sample in it)."""
+    return cap / 2 + STEP / 4 + rmap.grid.resolution
+
+
+def _along(path: np.ndarray, places: np.ndarray) -> np.ndarray:
+    """``np.gradient(path, axis=0)[places]``, worked out at ``places`` alone with the same
+    arithmetic (half the central difference inside, the one-sided difference at the ends)."""
+    last = len(path) - 1
+    d = path[np.minimum(places + 1, last)] - path[np.maximum(places - 1, 0)]
+    inside = (places > 0) & (places < last)
+    d[inside] /= 2.0
+    return d
 
 
 def _cosine(u: np.ndarray | None, v: np.ndarray | None) -> float:
