@@ -424,6 +424,17 @@ def finite_outcome(code: int, err: str, out: str) -> tuple[str, str]:
 MOST_RUNS = 12
 
 
+def not_run(argv: list[str]) -> tuple[str, str] | None:
+    """The outcome of a command line the harness does not run: one the system would refuse,
+    or a long run the user asked for."""
+    if not possible(argv):
+        return "refused", "argument list too long (the system refuses to run it)"
+    asked = long_run(argv)
+    if asked:
+        return "refused", f"not run: {asked} (a long run the user asked for)"
+    return None
+
+
 def long_run(argv: list[str]) -> str:
     """What a `simulate` or `compare` command line asks for that is too long for a campaign
     ('' if nothing): more than :data:`MOST_RUNS` runs (`compare`: runs times worlds times
@@ -450,11 +461,9 @@ def via_cli(kind: Kind, how: str, limit: float) -> Callable:
     """``kind.run`` replaced by the ``mitos`` command that reads the input."""
     def run(data, work: Path):
         argv = kind.argv(data, work)
-        if not possible(argv):
-            return "refused", "argument list too long (the system refuses to run it)"
-        asked = long_run(argv)
-        if asked:
-            return "refused", f"not run: {asked} (a long run the user asked for)"
+        refused = not_run(argv)
+        if refused is not None:
+            return refused
         if how == "subprocess":
             return finite_outcome(*cli_subprocess(argv, work, timeout=3 * limit + 10))
         return finite_outcome(*cli_in_process(argv, work))
@@ -756,11 +765,9 @@ class Kinds:
 
     def run_runs(self, text: str, work: Path) -> tuple[str, str]:
         argv = self.argv_runs(text, work)
-        if not possible(argv):
-            return "refused", "argument list too long (the system refuses to run it)"
-        asked = long_run(argv)
-        if asked:
-            return "refused", f"not run: {asked} (a long run the user asked for)"
+        refused = not_run(argv)
+        if refused is not None:
+            return refused
         return finite_outcome(*cli_in_process(argv, work))
 
     # -- seeds --------------------------------------------------------------------------------
