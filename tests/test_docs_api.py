@@ -86,6 +86,26 @@ def test_the_counts_of_the_drive_behavior_the_benchmark_pages_give_are_its_own()
     assert said and int(said[1]) == len(compiled.rules)
 
 
+def test_the_readme_counts_debians_examples_as_the_conformance_page_does():
+    """The README said 66 of Debian's 78 fuzzylite files load and 13 of those that do not
+    match differ between fuzzylite's versions, and so did docs/conformance.md's part 2 prose,
+    while its summary table (and `bench_conformance.py` on 2026-12-08: 51 match, 17 differ,
+    10 refused) had 68 loading since night 14. The three give one count."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    page = (ROOT / "docs" / "conformance.md").read_text(encoding="utf-8")
+    said = re.search(r"(\d+) of the (\d+) example files Debian ships\s+with fuzzylite 6 to its "
+                     r"binary's tables \((\d+) load; (\d+) of the other (\d+) differ", readme)
+    row = re.search(r"\| 2\. Debian `fuzzylite` 6 examples .*?\| (\d+) \| \*\*(\d+)\*\* .*?\| "
+                    r"\*\*(\d+)\*\* .*?\| (\d+) ", page)
+    prose = re.search(r"(\d+) of the (\d+) files load .*?and (\d+)\s+of them match.*?"
+                      r"Of the other (\d+), (\d+) differ from fuzzylite 6", page, re.S)
+    assert said and row and prose
+    matched, files, loaded, versions, other = map(int, said.groups())
+    assert (files, loaded, matched) == tuple(map(int, row.groups()[:3]))
+    assert files == loaded + int(row[4]) and other == loaded - matched
+    assert (loaded, files, matched, other, versions) == tuple(map(int, prose.groups()))
+
+
 def _mitos_commands() -> dict:
     """Every command by its name after ``mitos`` (``plot terms`` for a subcommand)."""
     import typer.main
