@@ -106,6 +106,22 @@ def test_the_readme_counts_debians_examples_as_the_conformance_page_does():
     assert (loaded, files, matched, other, versions) == tuple(map(int, prose.groups()))
 
 
+def test_the_animation_plots_md_times_is_the_run_it_names():
+    """docs/plots.md timed `mitos simulate moving --animate run.gif` as "the whole run, 26.85
+    s and 269 frames"; the run ends after 26.80 s (its ticks times `dt`, as `simulate` says
+    it). The time and the frame count it gives are the run's."""
+    from mitos_cli.draw.animation import frame_ticks
+    from mitos_cli.sim import load_world, simulate
+
+    page = (ROOT / "docs" / "plots.md").read_text(encoding="utf-8")
+    said = re.search(r"mitos simulate (\w+) --animate\s+run\.gif` \(the whole run, ([\d.]+) s "
+                     r"and (\d+) frames", page)
+    assert said
+    res = simulate(load_world(said[1]))
+    assert f"{res.t[-1]:.2f}" == said[2]
+    assert len(frame_ticks(res.ticks, res.world.dt, 10.0)) == int(said[3])
+
+
 def _mitos_commands() -> dict:
     """Every command by its name after ``mitos`` (``plot terms`` for a subcommand)."""
     import typer.main
