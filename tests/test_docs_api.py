@@ -507,6 +507,58 @@ def test_every_pages_quick_commands_run_as_written(page, where, tmp_path, monkey
     assert ran and failed == [], failed
 
 
+# The README's exit-code table names its usage errors by example (`--seed 1_0`, `corridor
+# corridor`, `--planner fuzzy dwa`, `mitos check --rulebase x.rules`, MATLAB's `gensurf`):
+# each, as written there, and a command line that makes it, which exits 2.
+README_USAGE_ERRORS = [
+    ("`--seed 1_0`", ["simulate", "--seed", "1_0"]),
+    ("10000, not `abc` ``", ["check", "-n", "abc"]),
+    ("`-b ''`", ["eval", "-b", "", "road=78"]),
+    ("`--var ''`", ["plot", "terms", "--var", ""]),
+    ("`--x road --x size`", ["plot", "surface", "--x", "road", "--x", "size"]),
+    ("`corridor corridor`", ["simulate", "corridor", "corridor"]),
+    ("`corridor corridor`", ["compare", "corridor", "corridor"]),
+    ("`a.yaml ./a.yaml`", ["simulate", "a.yaml", "./a.yaml"]),
+    ("`--every` without `--trace`", ["simulate", "--every", "3"]),
+    ("`--on-no-rule` without `--batch`", ["eval", "--on-no-rule", "nan", "road=78"]),
+    ("`--planner dwb`", ["simulate", "--planner", "dwb"]),
+    ("`--require succes`", ["simulate", "--require", "succes"]),
+    ("`--and prodct`", ["compare", "corridor", "--and", "prodct"]),
+    ("`--to fsl`", ["convert", "rulebases/mitos.rules", "--to", "fsl"]),
+    ("`--planner fuzzy dwa`", ["compare", "corridor", "--planner", "fuzzy", "dwa"]),
+    ("`simulate --planner fuzzy,dwa`", ["simulate", "--planner", "fuzzy,dwa"]),
+    ("`mitos check --rulebase x.rules`", ["check", "--rulebase", "x.rules"]),
+    ("a CSV option of `eval` answered with `--batch`", ["eval", "--csv", "x.csv"]),
+    ("`gensurf`", ["gensurf"]),
+    ("`plotmf`", ["plotmf"]),
+    ("`ruleview`", ["ruleview"]),
+]
+
+
+def test_the_readmes_usage_errors_exit_2(tmp_path, monkeypatch, capsys):
+    from mitos_cli.cli.app import main
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    row = next(line for line in text.splitlines() if line.startswith("| 2 | a usage error"))
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a.yaml").write_text((ROOT / "worlds" / "corridor.yaml").read_text("utf-8"),
+                                     encoding="utf-8")
+    wrong = []
+    for said, argv in README_USAGE_ERRORS:
+        if said not in row:
+            wrong.append(f"the README's row 2 no longer says {said}")
+            continue
+        try:
+            main(argv)
+            code = 0
+        except SystemExit as exc:
+            code = exc.code
+        if code != 2:
+            wrong.append(f"mitos {' '.join(argv)}: exit {code}: {capsys.readouterr().err[:200]}")
+        capsys.readouterr()
+    assert wrong == []
+
+
 def test_the_command_rule_finds_the_commands_the_pages_hold():
     """The rule above runs the commands it is meant to, and reads the files and values the
     pages give."""
