@@ -116,9 +116,9 @@ def exists(path: Path) -> bool:
 
 
 def display_path(path: str | None) -> str:
-    """A rule-base path as users should read it: relative to here, or marked as packaged."""
+    """A rule-base path as users should read it: relative to here, or marked as packaged; by
+    the names given, not the place a symbolic link on the way leads to."""
     import os
-    from pathlib import Path
 
     if not path:
         return "<rules>"
@@ -126,7 +126,7 @@ def display_path(path: str | None) -> str:
     if packaged is not None:
         return f"{packaged} (packaged)"
     try:
-        return os.path.relpath(Path(path).resolve())
+        return os.path.relpath(path)
     except ValueError:
         return str(path)
 

@@ -86,6 +86,63 @@ def test_the_counts_of_the_drive_behavior_the_benchmark_pages_give_are_its_own()
     assert said and int(said[1]) == len(compiled.rules)
 
 
+def test_the_readme_counts_debians_examples_as_the_conformance_page_does():
+    """The README said 66 of Debian's 78 fuzzylite files load and 13 of those that do not
+    match differ between fuzzylite's versions, and so did docs/conformance.md's part 2 prose,
+    while its summary table (and `bench_conformance.py` on 2026-12-08: 51 match, 17 differ,
+    10 refused) had 68 loading since night 14. The three give one count."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    page = (ROOT / "docs" / "conformance.md").read_text(encoding="utf-8")
+    said = re.search(r"(\d+) of the (\d+) example files Debian ships\s+with fuzzylite 6 to its "
+                     r"binary's tables \((\d+) load; (\d+) of the other (\d+) differ", readme)
+    row = re.search(r"\| 2\. Debian `fuzzylite` 6 examples .*?\| (\d+) \| \*\*(\d+)\*\* .*?\| "
+                    r"\*\*(\d+)\*\* .*?\| (\d+) ", page)
+    prose = re.search(r"(\d+) of the (\d+) files load .*?and (\d+)\s+of them match.*?"
+                      r"Of the other (\d+), (\d+) differ from fuzzylite 6", page, re.S)
+    assert said and row and prose
+    matched, files, loaded, versions, other = map(int, said.groups())
+    assert (files, loaded, matched) == tuple(map(int, row.groups()[:3]))
+    assert files == loaded + int(row[4]) and other == loaded - matched
+    assert (loaded, files, matched, other, versions) == tuple(map(int, prose.groups()))
+
+
+def test_the_readmes_unmet_speed_aims_are_its_tables_figures():
+    """The README's table gave night 24's 1,345 and 1,499 ticks/s and 30.64 s, and the
+    paragraph under it night 23's "3.5-3.8x short": the shortfalls it states are those of the
+    figures in its table (5,000 ticks/s and 20 s aimed at)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    ticks = re.search(r"\| ([\d,]+) and ([\d,]+) ticks/s \(EPYC", text)
+    runs = re.search(r"in lockstep \| ([\d.]+) s, CPU", text)
+    said = re.search(r"one run at 5,000 ticks/s \(([\d.]+)-([\d.]+)x short .*?1,000 runs in 20 s "
+                     r"\(([\d.]+)x over", text)
+    assert ticks and runs and said
+    slow, fast = sorted(float(t.replace(",", "")) for t in ticks.groups())
+    assert (float(said[1]), float(said[2])) == (round(5000 / fast, 1), round(5000 / slow, 1))
+    assert float(said[3]) == round(float(runs[1]) / 20, 1)
+    # the batch: "not on one" core of the Xeon, where its table gives 1.00-1.08x there
+    batch = re.search(r"\| ([\d.]+)x a NumPy kernel hand-written for these 27 rules \(both on "
+                      r"the 2 cores; ([\d.]+)x on one core each; on the Xeon ([\d.]+)-([\d.]+)x "
+                      r"and ([\d.]+)-([\d.]+)x\)", text)
+    assert batch and min(map(float, batch.groups())) >= 1.0
+    assert "kernel's pace (>= 1.0x) is met on both machines, on two cores and on one" in text
+
+
+def test_the_animation_plots_md_times_is_the_run_it_names():
+    """docs/plots.md timed `mitos simulate moving --animate run.gif` as "the whole run, 26.85
+    s and 269 frames"; the run ends after 26.80 s (its ticks times `dt`, as `simulate` says
+    it). The time and the frame count it gives are the run's."""
+    from mitos_cli.draw.animation import frame_ticks
+    from mitos_cli.sim import load_world, simulate
+
+    page = (ROOT / "docs" / "plots.md").read_text(encoding="utf-8")
+    said = re.search(r"mitos simulate (\w+) --animate\s+run\.gif` \(the whole run, ([\d.]+) s "
+                     r"and (\d+) frames", page)
+    assert said
+    res = simulate(load_world(said[1]))
+    assert f"{res.t[-1]:.2f}" == said[2]
+    assert len(frame_ticks(res.ticks, res.world.dt, 10.0)) == int(said[3])
+
+
 def _mitos_commands() -> dict:
     """Every command by its name after ``mitos`` (``plot terms`` for a subcommand)."""
     import typer.main
@@ -469,6 +526,58 @@ def test_every_pages_quick_commands_run_as_written(page, where, tmp_path, monkey
         failed += [f"{code}: printed no `{value}`" for value in _said(comment)
                    if not re.search(rf"(?<![\w.]){re.escape(value)}(?![\d])", out)]
     assert ran and failed == [], failed
+
+
+# The README's exit-code table names its usage errors by example (`--seed 1_0`, `corridor
+# corridor`, `--planner fuzzy dwa`, `mitos check --rulebase x.rules`, MATLAB's `gensurf`):
+# each, as written there, and a command line that makes it, which exits 2.
+README_USAGE_ERRORS = [
+    ("`--seed 1_0`", ["simulate", "--seed", "1_0"]),
+    ("10000, not `abc` ``", ["check", "-n", "abc"]),
+    ("`-b ''`", ["eval", "-b", "", "road=78"]),
+    ("`--var ''`", ["plot", "terms", "--var", ""]),
+    ("`--x road --x size`", ["plot", "surface", "--x", "road", "--x", "size"]),
+    ("`corridor corridor`", ["simulate", "corridor", "corridor"]),
+    ("`corridor corridor`", ["compare", "corridor", "corridor"]),
+    ("`a.yaml ./a.yaml`", ["simulate", "a.yaml", "./a.yaml"]),
+    ("`--every` without `--trace`", ["simulate", "--every", "3"]),
+    ("`--on-no-rule` without `--batch`", ["eval", "--on-no-rule", "nan", "road=78"]),
+    ("`--planner dwb`", ["simulate", "--planner", "dwb"]),
+    ("`--require succes`", ["simulate", "--require", "succes"]),
+    ("`--and prodct`", ["compare", "corridor", "--and", "prodct"]),
+    ("`--to fsl`", ["convert", "rulebases/mitos.rules", "--to", "fsl"]),
+    ("`--planner fuzzy dwa`", ["compare", "corridor", "--planner", "fuzzy", "dwa"]),
+    ("`simulate --planner fuzzy,dwa`", ["simulate", "--planner", "fuzzy,dwa"]),
+    ("`mitos check --rulebase x.rules`", ["check", "--rulebase", "x.rules"]),
+    ("a CSV option of `eval` answered with `--batch`", ["eval", "--csv", "x.csv"]),
+    ("`gensurf`", ["gensurf"]),
+    ("`plotmf`", ["plotmf"]),
+    ("`ruleview`", ["ruleview"]),
+]
+
+
+def test_the_readmes_usage_errors_exit_2(tmp_path, monkeypatch, capsys):
+    from mitos_cli.cli.app import main
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    row = next(line for line in text.splitlines() if line.startswith("| 2 | a usage error"))
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a.yaml").write_text((ROOT / "worlds" / "corridor.yaml").read_text("utf-8"),
+                                     encoding="utf-8")
+    wrong = []
+    for said, argv in README_USAGE_ERRORS:
+        if said not in row:
+            wrong.append(f"the README's row 2 no longer says {said}")
+            continue
+        try:
+            main(argv)
+            code = 0
+        except SystemExit as exc:
+            code = exc.code
+        if code != 2:
+            wrong.append(f"mitos {' '.join(argv)}: exit {code}: {capsys.readouterr().err[:200]}")
+        capsys.readouterr()
+    assert wrong == []
 
 
 def test_the_command_rule_finds_the_commands_the_pages_hold():

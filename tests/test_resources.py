@@ -68,3 +68,32 @@ def test_a_studys_report_names_a_packaged_world_by_its_name(tmp_path):
     text = render_markdown({"worlds": [str(packaged_path("worlds", "slalom.yaml")), str(mine)],
                             "choices": [], "runs": 1, "seed": 1}, [], [], {}, 0, 0)
     assert f"- worlds: `slalom (packaged)`, `{mine}`" in text.splitlines()
+
+
+def test_a_rule_base_reached_through_a_symbolic_link_is_named_as_given(tmp_path, monkeypatch,
+                                                                         capsys):
+    """In a checkout reached through a linked folder (`tests -> /elsewhere/tests`), `mitos
+    eval tests/data/interop/tipper.fis ...` headed its trace `rule base
+    ../../elsewhere/tests/data/interop/tipper.fis`, and `mitos check` named the file so in its
+    summary but as given in its findings: the label followed the link. It names the file as
+    the user gave it, relative to here, as the findings do."""
+    from pathlib import Path
+
+    from mitos_cli.cli.app import main
+    from mitos_cli.resources import display_path
+
+    real = tmp_path / "elsewhere" / "data"
+    real.mkdir(parents=True)
+    source = Path(__file__).parent / "data" / "interop" / "tipper.fis"
+    (real / "tipper.fis").write_bytes(source.read_bytes())
+    here = tmp_path / "here"
+    here.mkdir()
+    (here / "linked").symlink_to(real, target_is_directory=True)
+    monkeypatch.chdir(here)
+    assert display_path("linked/tipper.fis") == "linked/tipper.fis"
+    assert display_path(str(here / "linked" / "tipper.fis")) == "linked/tipper.fis"
+    try:
+        main(["eval", "linked/tipper.fis", "service=2", "food=1"])
+    except SystemExit as exc:
+        assert not exc.code
+    assert capsys.readouterr().out.startswith("rule base linked/tipper.fis, behavior main")
