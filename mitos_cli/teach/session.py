@@ -187,7 +187,9 @@ class Session:
         #: lesson may come from anyone, and its `save /any/where.rules` wrote over that file
         self.confined: Path | None = None
         self.saved_seq = 0
-        self.interrupted = False            # the last command's adaptation was cut short
+        #: what cut the last command's adaptation short (Ctrl-C, or a SIGTERM's or SIGHUP's
+        #: Terminated), to be raised again once what it learned is journaled
+        self.interrupted: KeyboardInterrupt | None = None
         self.opened_at: Span | None = None  # where a lesson opened the behavior still open
         self.state = State(self.original, active)
         self._indexes: dict[str, _RuleIndex] = {}
@@ -908,7 +910,8 @@ class Session:
                               hint="adapt again to go on from where it stopped")
         rate = DEFAULT_RATE if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
-        self.interrupted = result.interrupted
+        self.interrupted = result.stopped_by or (KeyboardInterrupt() if result.interrupted
+                                                 else None)
         before = self.rulebase
         terms, crisp = learned_changes(before, learned_rulebase(result.parameters,
                                                                 result.values))
