@@ -161,13 +161,13 @@ def _read_stdin() -> str:
     data = buffer.read(limit)
     if len(data) >= limit:              # past the limit whatever it holds: said by its size
         return data.decode("utf-8-sig", errors="replace")
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        from ..fileio import bad_byte, unreadable
+    from ..fileio import bad_byte, decode_text, text_encoding_hint, unreadable
 
-        raise LessonError(unreadable("lesson", "<stdin>", exc),
-                          span=bad_byte("<stdin>", exc)) from None
+    try:
+        return decode_text(data)
+    except UnicodeDecodeError as exc:
+        raise LessonError(unreadable("lesson", "<stdin>", exc), span=bad_byte("<stdin>", exc),
+                          hint=text_encoding_hint(exc)) from None
 
 
 def read_lesson(source: str) -> tuple[str, str]:
@@ -183,12 +183,13 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
-    from ..fileio import bad_byte, broken_link, read_text, unreadable
+    from ..fileio import bad_byte, broken_link, read_text, text_encoding_hint, unreadable
 
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
+        error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc),
+                            hint=text_encoding_hint(exc))
         if isinstance(exc, FileNotFoundError) and broken_link("lesson", path) is None:
             # a mistyped name: a lesson file beside it, else the packaged lessons
             from ..errors import did_you_mean
