@@ -550,10 +550,13 @@ class Session:
         return exc
 
     def _term_refs(self, refs: Iterable[Sequence[str]]) -> list[list[str]]:
+        """The terms ``refs`` (``frozen``, ``unfrozen``) names, checked: an unknown variable is
+        a name error, as an unknown term or rule label is (it was a lesson error, a "command
+        error" at the prompt), with its "did you mean"."""
         variables = self.rulebase.variables
         for var, term in refs:
             if var not in variables:
-                raise unknown("variable", var, list(variables), cls=LessonError)
+                raise unknown("variable", var, list(variables))
             variables[var].term(term)                    # unknown term: did you mean
         return [list(r) for r in refs]
 
