@@ -370,6 +370,20 @@ class NoRulesError(FormatError):
         self.termset = termset
 
 
+class Terminated(KeyboardInterrupt):
+    """A SIGTERM (``kill PID``, a batch scheduler's time limit) or a SIGHUP (the terminal
+    closed, an ssh session dropped) raised where the command is, as Ctrl-C raises
+    KeyboardInterrupt: what stops cleanly on one stops so on the others. ``code`` is the
+    exit code a shell expects of the signal (143, 129). Not a user's mistake, but here, the
+    lowest stage, since the teaching prompt, which goes on after a Ctrl-C, must tell it from
+    one and end (the handler that raises it is the CLI's,
+    :func:`mitos_cli.cli.progress.terminate_as_interrupt`)."""
+
+    def __init__(self, code: int = 143) -> None:
+        super().__init__()
+        self.code = code
+
+
 def closest(name: str, candidates: Iterable[str]) -> str | None:
     """The candidate closest to ``name`` (as written, then in any case, then the one name it
     begins), or ``None`` when nothing is close. A name over thrice the longest candidate is

@@ -114,8 +114,90 @@ def broken_link(kind: str, path: str | Path) -> str | None:
 def read_text(path: str | Path) -> str:
     """A file the user named, as text: UTF-8, with or without a byte-order mark (which is not
     content), read as :func:`read_bytes` reads it. Raises ``OSError`` (with a ``strerror`` to
-    show) or ``UnicodeDecodeError``, as ``Path.read_text`` does."""
-    return read_bytes(path).decode("utf-8-sig")
+    show) or ``UnicodeDecodeError`` (:class:`WideText` for UTF-16 or UTF-32), as
+    ``Path.read_text`` does."""
+    return decode_text(read_bytes(path))
+
+
+def decode_text(data: bytes) -> str:
+    """The text of a file's (or stdin's) bytes, the one way every text MITOS reads is decoded:
+    UTF-8, a byte-order mark dropped. UTF-16 or UTF-32 (an editor's "Unicode", PowerShell's
+    `>`), with its byte-order mark or without, raises :class:`WideText`: without the mark,
+    ASCII in UTF-16 is valid UTF-8 with a NUL after each character, and was refused by the
+    parser at its first NUL (`unexpected character '\x00'`), in no words about its
+    encoding."""
+    wide = wide_text(data)
+    if wide is not None:
+        raise wide
+    return data.decode("utf-8-sig")
+
+
+class WideText(UnicodeDecodeError):
+    """Text in UTF-16 or UTF-32, which MITOS does not read: ``encoding`` as iconv names it
+    (``UTF-16LE``; ``UTF-16`` with a byte-order mark, which says the order), ``order``
+    (``little-endian``), ``marked`` (it begins with its byte-order mark); ``start`` is its
+    first NUL byte (the mark's first byte in a file with none)."""
+
+    def __init__(self, data: bytes, units: int, little: bool, marked: bool) -> None:
+        name = f"UTF-{8 * units}"
+        start = max(0, data.find(b"\0"))
+        super().__init__("utf-8", data, start, start + 1, f"it looks like {name} text")
+        self.name = name
+        self.order = "little-endian" if little else "big-endian"
+        self.marked = marked
+        self.encoding = name if marked else name + ("LE" if little else "BE")
+
+    def described(self) -> str:
+        """``UTF-16 text (little-endian, without a byte-order mark), not UTF-8 (its first NUL
+        byte is at line 1, column 2)``."""
+        mark = "with its byte-order mark" if self.marked else "without a byte-order mark"
+        where = byte_span(None, self.object, self.start)
+        first = (f"its first NUL byte is at line {where.line}, column {where.column}"
+                 if self.object[self.start] == 0 else "it begins with that mark")
+        return f"{self.name} text ({self.order}, {mark}), not UTF-8 ({first})"
+
+
+#: How many bytes of a file :func:`wide_text` looks at.
+WIDE_HEAD = 1024
+
+#: Byte-order marks, the longest first (UTF-32LE's begins with UTF-16LE's): (mark, code unit
+#: bytes, little-endian).
+_MARKS = ((b"\xff\xfe\x00\x00", 4, True), (b"\x00\x00\xfe\xff", 4, False),
+          (b"\xff\xfe", 2, True), (b"\xfe\xff", 2, False))
+
+
+def wide_text(data: bytes) -> WideText | None:
+    """:class:`WideText` when ``data`` looks like UTF-16 or UTF-32: it begins with their
+    byte-order mark; or, without a mark, its NUL bytes fall at the places
+    of the high bytes of characters below U+0100 (UTF-16LE: each second byte) in at least a
+    quarter of its first characters, and hardly ever elsewhere. A UTF-8 text holds no NUL
+    (a stray one, or binary junk whose zeros fall anywhere, is no such pattern); else
+    ``None``."""
+    for mark, units, little in _MARKS:    # (no UTF-8 text begins with 0xff, 0xfe or NULs)
+        if data.startswith(mark):
+            return WideText(data, units, little, marked=True)
+    if b"\0" not in data:
+        return None
+    head = data[:WIDE_HEAD]
+    for units in (4, 2):
+        chars = len(head) // units
+        if chars < 2:
+            continue
+        nuls = [head[i::units][:chars].count(0) for i in range(units)]
+        for little in (True, False):
+            low = 0 if little else units - 1           # the byte of the character's value
+            high = [n for i, n in enumerate(nuls) if i != low]
+            if min(high) >= max(2, chars // 4) and nuls[low] * 8 <= min(high):
+                return WideText(data, units, little, marked=False)
+    return None
+
+
+def text_encoding_hint(exc: OSError | UnicodeDecodeError) -> str | None:
+    """What to do with a file :func:`read_text` refused as :class:`WideText`; else ``None``."""
+    if not isinstance(exc, WideText):
+        return None
+    return (f"save it as UTF-8 (an editor's \"save with encoding\", or `iconv -f "
+            f"{exc.encoding} -t UTF-8 FILE > NEW`)")
 
 
 def read_bytes(path: str | Path) -> bytes:
@@ -148,9 +230,19 @@ def why_unreadable(exc: OSError | UnicodeDecodeError) -> str:
     if isinstance(exc, UnicodeDecodeError):
         where = bad_byte(None, exc)
         assert where is not None
+        if isinstance(exc, WideText):
+            return f"it looks like {exc.described()}"
         return (f"it is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at line "
                 f"{where.line}, column {where.column})")
     return str(exc.strerror or exc)
+
+
+def not_text(path: object, exc: UnicodeDecodeError) -> str:
+    """A file that is not UTF-8, said as a rule file's and a term set's refusal says it:
+    ``not a text file (byte 0xff is not UTF-8)``, or what :class:`WideText` it looks like."""
+    if isinstance(exc, WideText):
+        return f"`{path}` looks like {exc.described()}"
+    return f"`{path}` is not a text file (byte 0x{exc.object[exc.start]:02x} is not UTF-8)"
 
 
 def bad_byte(path: object, exc: OSError | UnicodeDecodeError) -> Span | None:

@@ -6,6 +6,8 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from mitos_cli.errors import MitosError, TermSetError
 from mitos_cli.fileio import atomic_file, atomic_write
@@ -269,3 +271,164 @@ def test_an_output_named_by_a_link_in_a_loop_is_refused(tmp_path, capsys, monkey
         check_writable(tmp_path / name)
     with pytest.raises(MitosError, match="symbolic links"):
         atomic_write(tmp_path / name, "x")
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Each of the readers of text files, as a user meets it: (what is written, how the command
+#: line reads it).
+READERS = {
+    "rule file": ("rb/a.rules", ["check", "rb/a.rules"]),
+    "term set": ("rb/mitos.terms.yaml", ["check", "rb/mitos.rules"]),
+    "world": ("w.yaml", ["simulate", "w.yaml"]),
+    "map YAML": ("office02.yaml", ["simulate", "office.yaml"]),
+    "lesson": ("a.lesson", ["teach", "rb/mitos.rules", "--lesson", "a.lesson"]),
+    "lesson on stdin": ("-", ["teach", "rb/mitos.rules", "--lesson", "-"]),
+    "batch CSV": ("b.csv", ["eval", "rb/mitos.rules", "--batch", "b.csv"]),
+    "batch CSV on stdin": ("-", ["eval", "rb/mitos.rules", "--batch", "-"]),
+    ".fis": ("t.fis", ["check", "t.fis"]),
+    ".fcl": ("t.fcl", ["check", "t.fcl"]),
+    ".fll": ("t.fll", ["check", "t.fll"]),
+}
+
+#: How each encoding is written, its words, and where its first NUL byte is in ``ab...``.
+ENCODINGS = {
+    "UTF-16LE": (lambda t: t.encode("utf-16-le"),
+                 "UTF-16 text (little-endian, without a byte-order mark)", 2),
+    "UTF-16BE": (lambda t: t.encode("utf-16-be"),
+                 "UTF-16 text (big-endian, without a byte-order mark)", 1),
+    "UTF-16LE with its mark": (lambda t: b"\xff\xfe" + t.encode("utf-16-le"),
+                               "UTF-16 text (little-endian, with its byte-order mark)", 4),
+    "UTF-16BE with its mark": (lambda t: b"\xfe\xff" + t.encode("utf-16-be"),
+                               "UTF-16 text (big-endian, with its byte-order mark)", 3),
+}
+
+
+def _good_files(tmp_path: Path) -> dict[str, str]:
+    """The UTF-8 text of each reader's file, which reads."""
+    import shutil
+
+    rulebases = ROOT / "rulebases"
+    (tmp_path / "rb").mkdir()
+    for f in rulebases.iterdir():
+        if f.is_file():
+            shutil.copy(f, tmp_path / "rb" / f.name)
+    (tmp_path / "mrpb_office02.pgm").write_bytes((ROOT / "worlds/maps/mrpb_office02.pgm").read_bytes())
+    office = (ROOT / "worlds/office.yaml").read_text().replace("maps/mrpb_office02.yaml",
+                                                                 "office02.yaml")
+    (tmp_path / "office.yaml").write_text(office)
+    interop = ROOT / "tests/data/interop"
+    return {
+        "rb/a.rules": (rulebases / "mitos.rules").read_text(),
+        "rb/mitos.terms.yaml": (rulebases / "mitos.terms.yaml").read_text(),
+        "w.yaml": (ROOT / "tests/data/tiny.yaml").read_text(),
+        "office02.yaml": (ROOT / "worlds/maps/mrpb_office02.yaml").read_text(),
+        "a.lesson": "use drive\nshow rules\n",
+        "b.csv": "road,size,position\n78,45,4\n",
+        "t.fis": (interop / "tipper.fis").read_text(),
+        "t.fcl": (interop / "dimmer_fuzzylite.fcl").read_text(),
+        "t.fll": (interop / "check_formula_input.fll").read_text(),
+    }
+
+
+def _run(argv: list[str], stdin: bytes | None, capsys, monkeypatch) -> tuple[int, str]:
+    import io
+    import sys
+
+    from mitos_cli.cli.app import main
+
+    if stdin is not None:
+        monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(stdin)))
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    return info.value.code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("encoding", ENCODINGS)
+@pytest.mark.parametrize("reader", READERS)
+def test_a_file_in_utf16_is_said_to_be_so_by_every_reader(tmp_path, monkeypatch, capsys, reader,
+                                                          encoding):
+    """A UTF-16 file without its byte-order mark (`iconv -t UTF-16LE`) was refused at its
+    first NUL as "unexpected character '\\x00'" (valid UTF-8: ASCII with a NUL after each
+    character), with its mark as "not a text file (byte 0xff is not UTF-8)"; each reader now
+    says what it looks like, where its first NUL byte is, and to save it as UTF-8."""
+    monkeypatch.chdir(tmp_path)
+    texts = _good_files(tmp_path)
+    name, argv = READERS[reader]
+    encode, words, column = ENCODINGS[encoding]
+    text = texts["a.lesson" if "lesson" in reader else "b.csv" if "CSV" in reader else name]
+    data = encode(text)
+    stdin = data if name == "-" else None
+    if stdin is None:
+        (tmp_path / name).write_bytes(data)
+    code, err = _run(argv, stdin, capsys, monkeypatch)
+    shown = "<stdin>" if name == "-" else name
+    assert code == 1, err
+    head, hint = err.splitlines()[0], err.splitlines()[-1]
+    assert head.startswith(f"{shown}:1:{column}: ")
+    assert head.endswith(f"looks like {words}, not UTF-8 (its first NUL byte is at line 1, "
+                         f"column {column})")
+    iconv = encoding.split()[0] if "mark" not in encoding else "UTF-16"
+    assert hint == (f'hint: save it as UTF-8 (an editor\'s "save with encoding", or `iconv -f '
+                    f'{iconv} -t UTF-8 FILE > NEW`)')
+
+
+@pytest.mark.parametrize("reader", READERS)
+def test_every_reader_reads_its_utf8_file(tmp_path, monkeypatch, capsys, reader):
+    """The same files in UTF-8 (the check above refuses only UTF-16)."""
+    monkeypatch.chdir(tmp_path)
+    texts = _good_files(tmp_path)
+    name, argv = READERS[reader]
+    for file, text in texts.items():
+        (tmp_path / file).write_text(text)
+    stdin = (texts["a.lesson"] if "lesson" in reader else texts["b.csv"]).encode() \
+        if name == "-" else None
+    if reader == "map YAML":
+        argv = [*argv, "--json"]
+    code, err = _run(argv, stdin, capsys, monkeypatch)
+    assert code == 0, err
+
+
+def test_the_whole_message_of_a_utf16_rule_file(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a.rules").write_bytes("r1: if road is NARROW then steering is LB\n"
+                                       .encode("utf-16-le"))
+    code, err = _run(["check", "a.rules"], None, capsys, monkeypatch)
+    assert code == 1
+    assert err == (
+        "a.rules:1:2: rule base error: `a.rules` looks like UTF-16 text (little-endian, without "
+        "a byte-order mark), not UTF-8 (its first NUL byte is at line 1, column 2)\n"
+        "hint: save it as UTF-8 (an editor's \"save with encoding\", or `iconv -f UTF-16LE -t "
+        "UTF-8 FILE > NEW`)\n")
+
+
+@pytest.mark.parametrize(("codec", "encoding"), [
+    ("utf-16-le", "UTF-16LE"), ("utf-16-be", "UTF-16BE"), ("utf-32-le", "UTF-32LE"),
+    ("utf-32-be", "UTF-32BE"), ("utf-16", "UTF-16"), ("utf-32", "UTF-32")])
+@given(text=st.text(st.characters(max_codepoint=0xFF, blacklist_characters="\x00"),
+                    min_size=2, max_size=300))
+def test_text_below_u0100_in_utf16_or_utf32_is_told_by_its_nul_bytes(codec, encoding, text):
+    from mitos_cli.fileio import WideText, decode_text, wide_text
+
+    data = text.encode(codec)
+    found = wide_text(data)
+    assert isinstance(found, WideText) and found.encoding == encoding
+    assert found.start == data.find(b"\0") >= 0
+    with pytest.raises(WideText):
+        decode_text(data)
+
+
+@given(text=st.text(st.characters(blacklist_characters="\x00")),
+       nuls=st.lists(st.integers(0, 10_000), max_size=3), mark=st.booleans())
+def test_utf8_text_is_never_taken_for_utf16(text, nuls, mark):
+    """A legitimate UTF-8 text (no NUL) reads as it is, with or without its mark; a stray NUL
+    or three in it are left to the reader to refuse at their place, not said to be UTF-16."""
+    from mitos_cli.fileio import decode_text, wide_text
+
+    data = (b"\xef\xbb\xbf" if mark else b"") + text.encode()
+    assert decode_text(data) == data.decode("utf-8-sig")
+    if len(text) > 40:
+        for at in nuls:
+            at %= len(data)
+            data = data[:at] + b"\0" + data[at:]
+        assert wide_text(data) is None

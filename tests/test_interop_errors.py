@@ -716,9 +716,13 @@ def test_a_windows_1252_name_reaches_the_rules(tmp_path: Path) -> None:
 @pytest.mark.parametrize("data, message, at", [
     (b"[System]\nName='a\x00\xb0'\n", r"\(byte 0x00 at line 2, column 8\)$", (2, 8)),
     (b"[System]\nName='a\x00b'\n", r"\(byte 0x00 at line 2, column 8\)$", (2, 8)),   # UTF-8
-    ("[System]\nName='a'\n".encode("utf-16-le"), "looks like UTF-16 text", (1, 2)),
-    ("[System]\n".encode("utf-16"), "is UTF-16 text", (1, 1)),
-    ("[System]\n".encode("utf-32"), "is UTF-32 text", (1, 1)),
+    # UTF-16 and UTF-32, with their mark or without: at the first NUL, as every reader says it
+    ("[System]\nName='a'\n".encode("utf-16-le"), "looks like UTF-16 text \\(little-endian, "
+     "without a byte-order mark\\)", (1, 2)),
+    (b"\xff\xfe" + "[System]\n".encode("utf-16-le"), "looks like UTF-16 text \\(little-endian, "
+     "with its", (1, 4)),
+    (b"\x00\x00\xfe\xff" + "[System]\n".encode("utf-32-be"), "looks like UTF-32 text "
+     "\\(big-endian, with its", (1, 1)),
     # 0xe9 is é in Windows-1252: the byte it leaves undefined is the one refused
     (b"[System]\n\xe9\x81\n", "byte 0x81 at line 2, column 2 is neither UTF-8 nor", (2, 2)),
     # UTF-8 on one line, a Windows-1252 degree sign on another: as one, the other is garbled

@@ -96,3 +96,25 @@ def test_along_is_step_at_its_ends_and_at_each_substep(seed):
     points = np.array([kinematics.along(*state, limits, 0.05, 4, f)[:2]
                        for f in np.linspace(0, 1, 101)])
     assert np.hypot(*np.diff(points, axis=0).transpose(1, 0, 2)).max() <= 60 * 0.05 / 100 + 1e-9
+
+
+def test_holding_commands_leaves_those_within_the_limits_to_the_bit():
+    """Only a number past a bound is replaced (`np.maximum(0.0, -0.0)` is -0.0, so a speed of
+    0 of a robot with no reverse, `max_reverse: 0`, would have read -0), and the kinematics
+    move from a held command as from the command itself."""
+    limits = kinematics.Limits.of([Robot(max_reverse=0.0), Robot(steering_min=40.0)])
+    bounds = kinematics.command_bounds(limits)
+    command = np.array([[90.0, 0.0], [200.0, -0.0]])
+    kinematics.hold_commands(command, bounds)
+    assert command.tolist() == [[90.0, 0.0], [150.0, -0.0]]
+    assert np.signbit(command[:, 1]).tolist() == [False, True]
+    command = np.array([[-5.0, -30.0], [30.0, 900.0]])
+    kinematics.hold_commands(command, bounds)
+    assert command.tolist() == [[30.0, 0.0], [40.0, 60.0]]
+    assert not np.signbit(command[0, 1])                    # backward, held to 0: not -0
+    state = (np.zeros(2), np.zeros(2), np.zeros(2), np.array([5.0, 5.0]), np.full(2, 90.0))
+    wild = np.array([[-5.0, -30.0], [30.0, 900.0]])
+    assert np.array_equal(np.stack(kinematics.step(*state, wild[:, 0], wild[:, 1], limits,
+                                                   0.05, 2)),
+                          np.stack(kinematics.step(*state, command[:, 0], command[:, 1],
+                                                   limits, 0.05, 2)))

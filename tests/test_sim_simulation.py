@@ -216,6 +216,84 @@ def test_a_command_from_outside_drives_the_same_run_as_the_planner():
         sim.observe()
 
 
+@pytest.mark.parametrize("given, held", [
+    ([[200.0, 20.0]], [150.0, 20.0]),       # past the lock to the right
+    ([[-50.0, 500.0]], [30.0, 60.0]),       # past the lock to the left, past the top speed
+    ([[90.0, -100.0]], [90.0, -15.0]),      # faster backward than the robot drives
+    ([[150.0, 60.0]], [150.0, 60.0]),       # the limits themselves
+])
+def test_a_command_past_the_robots_limits_is_recorded_as_its_drive_takes_it(given, held):
+    """`Simulation.step([[200, 20]])` recorded a steering command of 200 while the wheel was
+    held to its lock at 150: the record, the CSV's `cmd_` columns and a `Tick` say what the
+    robot was told once held to its steering lock and top speeds (as the brake's and giving
+    way's caps are recorded), and the run is the one of the held command, bit for bit."""
+    from mitos_cli.sim.export import csv_text
+
+    world = short("figure4.yaml", 1.0)
+    sim, same = Simulation(world), Simulation(world)
+    while not sim.done:
+        tick = sim.step(given)
+        same.step([held])
+        assert tick.command.tolist() == [held]
+    same_run(sim.result(), same.result())
+    assert sim.result().command.reshape(-1, 2).tolist() == [held] * sim.ticks
+    rows = csv_text(sim.result(), sim.planner).splitlines()
+    head = rows[0].split(",")
+    first = rows[1].split(",")
+    assert [float(first[head.index(c)]) for c in ("cmd_steering", "cmd_speed")] == held
+
+
+class _Wild:
+    """A user's planner past every limit: steering 200 or -40 deg, speed 500 or -90 in/s."""
+
+    name = "wild"
+
+    def plan(self, p):
+        k = np.round(p.pose[:, 0]).astype(int)
+        return (np.where(k % 3 == 0, 200.0, np.where(k % 3 == 1, -40.0, 95.0)),
+                np.where(k % 4 == 0, 500.0, np.where(k % 4 == 1, -90.0, 25.0)))
+
+
+class _Held(_Wild):
+    """:class:`_Wild`'s commands held to the packaged robots' limits."""
+
+    def plan(self, p):
+        steer, speed = super().plan(p)
+        return np.clip(steer, 30.0, 150.0), np.clip(speed, -15.0, 60.0)
+
+
+def test_a_planners_commands_past_the_limits_are_recorded_held_alone_and_in_lockstep():
+    """A planner of one's own past the robots' limits, in a world of several robots, alone
+    and in lockstep (one batch): every recorded command lies within the limits, the brake
+    and giving way capped what was held, and the robots do what they do given the held
+    commands (the one record of the two planners, bit for bit)."""
+    from mitos_cli.sim.lockstep import run_lockstep
+
+    world = short("multirobot.yaml", 8.0)
+    alone = simulate(world, _Wild(), 1, randomise=True)
+    command = alone.command.reshape(-1, 2)
+    assert (command[:, 0] >= 30.0).all() and (command[:, 0] <= 150.0).all()
+    assert (command[:, 1] >= -15.0).all() and (command[:, 1] <= 60.0).all()
+    assert (command[:, 0] == 150.0).any() and (command[:, 1] == 60.0).any()
+    same_run(alone, simulate(world, _Held(), 1, randomise=True))
+    wild, held = (run_lockstep(world, planner, [1, 2], randomise=True)
+                  for planner in (_Wild(), _Held()))
+    same_run(wild[0], alone)
+    for a, b in zip(wild, held):
+        same_run(a, b)
+
+
+@pytest.mark.parametrize("bad", [[[np.nan, 20.0]], [[90.0, np.inf]], [[-np.inf, 20.0]]])
+def test_a_command_that_is_not_finite_is_refused_and_not_recorded(bad):
+    from mitos_cli.errors import CommandError
+
+    sim = Simulation(short("corridor.yaml", 1.0))
+    sim.step([[90.0, 20.0]])
+    with pytest.raises(CommandError, match="the command must be finite numbers"):
+        sim.step(bad)
+    assert sim.ticks == 1 and len(sim.result().t) == 1
+
+
 class _Gives:
     """A user's planner that commands what it is given, whatever the robots."""
 

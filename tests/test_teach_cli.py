@@ -719,3 +719,29 @@ def test_a_packaged_file_given_as_the_lesson_away_from_the_repository_says_what_
     directory) said only "lesson not found, expected a packaged lesson: wider-turn"."""
     res = mitos("teach", "--lesson", lesson, cwd=tmp_path)
     assert res.returncode == 1 and "not found" in res.stderr and says in res.stderr, res.stderr
+
+
+@pytest.mark.parametrize("command", ["frozen", "unfrozen"])
+def test_a_wrong_variable_and_a_wrong_term_in_frozen_are_one_kind_of_error(work, command):
+    """`frozen heading.AHED` (a wrong term) was a name error, `frozen headng.AHEAD` (a wrong
+    variable) a lesson error (a command error at the prompt): both are names that are not
+    defined, as `frozen r999` is; each with its "did you mean", in a lesson and at the
+    prompt, for `unfrozen` too."""
+    at = len(command) + 2
+    for told, wrong, words, hint, column in (
+            (f"{command} heading.AHED", "AHED", "unknown term `AHED` of `heading`",
+             "did you mean `AHEAD`?", at + len("heading.")),
+            (f"{command} headng.AHEAD", "headng", "unknown variable `headng`",
+             "did you mean `heading`?", at)):
+        (work / "f.lesson").write_text(f"use drive\n{told}\n")
+        res = mitos("teach", "rb/mitos.rules", "--lesson", "f.lesson", cwd=work)
+        assert res.returncode == 1
+        said = res.stderr.splitlines()
+        first = next(i for i, line in enumerate(said) if line.startswith("f.lesson:2:"))
+        assert said[first:first + 3] == [f"f.lesson:2:{column}: name error: {words}",
+                                         f"    {told}", " " * (3 + column) + "^" * len(wrong)]
+        assert said[-1] == f"hint: {hint}"
+        res = mitos("teach", "rb/mitos.rules", cwd=work, stdin=f"use drive\n{told}\nquit\n")
+        assert res.returncode == 0
+        assert f"<prompt>:2:{column}: name error: {words}\n" in res.stderr
+        assert f"hint: {hint}\n" in res.stderr

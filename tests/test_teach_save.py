@@ -878,6 +878,39 @@ def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rul
     assert "r28:" in rules.read_text() and not s.unsaved
 
 
+def test_a_sigterm_once_a_save_is_written_waits_until_it_is_journaled(rules, monkeypatch):
+    """A SIGTERM (which `mitos teach` answers as Ctrl-C) once a save over the original wrote
+    its files is raised after the session took note of them and journaled the save."""
+    import os
+    import signal
+    import time
+
+    import mitos_cli.teach.session as session_module
+    from mitos_cli.cli.progress import terminate_as_interrupt
+    from mitos_cli.errors import Terminated
+
+    s = Session(rules, out=[].append)
+    s.run("r27: if road is NARROW then speed is SLOW")
+    real = session_module.files_digest
+    calls: list = []
+
+    def signalled(rb):
+        calls.append(rb)
+        if len(calls) == 2:              # after the files are written (the first: before)
+            monkeypatch.setattr(session_module, "files_digest", real)
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.05)             # the signal is taken here
+        return real(rb)
+
+    monkeypatch.setattr(session_module, "files_digest", signalled)
+    with terminate_as_interrupt(), pytest.raises(Terminated):
+        s.run(f"save {rules}")
+    assert s.journal.entries[-1]["op"] == "save" and not s.unsaved
+    s.run("r28: if road is WIDE then speed is FAST")
+    s.run(f"save {rules}")
+    assert "r28:" in rules.read_text() and not s.unsaved
+
+
 def test_save_refuses_a_link_into_another_directory(tmp_path):
     """The rule file went where the link leads and its term sets beside the link, so the file
     written did not load; a link within the directory saves as before."""

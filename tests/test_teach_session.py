@@ -1146,6 +1146,43 @@ def test_ctrl_c_during_the_journal_write_keeps_the_journal_whole(rules, tmp_path
         ["r27", "r28"]
 
 
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGHUP"])
+def test_a_sigterm_or_sighup_during_the_journal_write_is_raised_once_it_is_counted(
+        rules, tmp_path, monkeypatch, name):
+    """`mitos teach` answers a SIGTERM and a SIGHUP as Ctrl-C (Terminated, a
+    KeyboardInterrupt); one during the journal line's fsync must wait, as Ctrl-C does, until
+    the line is synced and counted, or the next change is numbered alike."""
+    import os
+    import signal
+    import time
+
+    import mitos_cli.teach.journal as journal_module
+    from mitos_cli.cli.progress import terminate_as_interrupt
+    from mitos_cli.errors import Terminated
+
+    journal = Journal.create(tmp_path / "j")
+    s, _ = session(rules, journal=journal)
+    real = os.fsync
+    synced: list[int] = []
+
+    def signalled(fd):
+        monkeypatch.setattr(journal_module.os, "fsync", real)
+        os.kill(os.getpid(), getattr(signal, name))
+        time.sleep(0.05)                 # the signal is taken here, before the fsync
+        real(fd)
+        synced.append(fd)
+
+    monkeypatch.setattr(journal_module.os, "fsync", signalled)
+    with terminate_as_interrupt(), pytest.raises(Terminated) as stop:
+        s.run("r27: if road is NARROW then steering is LB")
+    assert stop.value.code == 128 + getattr(signal, name)
+    assert synced and [e["seq"] for e in journal.entries] == [1, 2]
+    s.run("r28: if road is WIDE then speed is FAST")
+    again = Session.resume(Journal.open(tmp_path / "j"), out=[].append)
+    assert [r.label for r in again.rulebase.behavior("avoid_obstacle").rules][-2:] == \
+        ["r27", "r28"]
+
+
 def test_a_rule_file_of_a_long_name_gets_a_session(tmp_path):
     """The session's directory is named after the rule file: a name of 245 characters made
     one of 261, which no file system allows, and the rule file could not be taught."""

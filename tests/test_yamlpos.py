@@ -46,7 +46,8 @@ def test_booleans_are_read_as_yaml_1_2_reads_them():
 
 
 @pytest.mark.parametrize("text,where,words,expected", [
-    ("a:\n\t- 1\n", (2, 1), "a tab, which YAML does not take", "spaces: YAML indents with spaces"),
+    ("a:\n\t- 1\n", (2, 1), "a tab in the indentation, which YAML does not take",
+     "spaces: YAML indents with spaces"),
     # a tab at a line's end (an editor's leftover; night 24's rewritings of the shipped files)
     # was said as a tab in the indentation, which YAML does not take: YAML takes it there,
     # PyYAML does not
@@ -117,6 +118,47 @@ def test_pyyamls_inner_words_are_never_shown(text, where, words, expected):
     assert words in err.message and expected in (err.expected or ""), err.render()
     for inner in ("<", "found", "expected", "node", "token", "indicator"):
         assert inner not in err.message, err.message
+
+
+@pytest.mark.parametrize("text,where,words,expected", [
+    # a tab inside a value without quotes was said as one YAML does not take "as indentation
+    # or to start a value", and the expected "spaces: YAML indents with spaces only"
+    ("name: a\tb\n", (1, 8), "a tab inside a value, after `a` (the YAML reader takes no tab in "
+     "a value that is not in quotes)", "a space in place of the tab, or the whole value in quotes"),
+    ("a:\n  name: x y\tz  # c\n", (2, 12), "a tab inside a value, after `y`", "in quotes"),
+    ("- a\tb\n", (1, 4), "a tab inside a value, after `a`", "a space in place of the tab"),
+    ("k: [a\tb]\n", (1, 6), "a tab inside a value, after `a`", "a space in place of the tab"),
+    ("name: a-\tb\n", (1, 9), "a tab inside a value, after `a-`", "in quotes"),
+    # where the value starts (YAML takes a tab there, PyYAML does not), and before a key's `:`
+    ("name:\tx\n", (1, 6), "a tab after `:`, where the value starts", "a space in place of"),
+    ("-\tb\n", (1, 2), "a tab after `-`, where the value starts", "a space in place of"),
+    ("k: [a,\tb]\n", (1, 7), "a tab after `,`, where the value starts", "a space in place of"),
+    ("key\t: 1\n", (1, 4), "a tab between the key `key` and its `:`", "`key: value`"),
+])
+def test_a_tab_is_said_by_where_it_stands(text, where, words, expected):
+    with pytest.raises(TermSetError) as info:
+        yamlpos.load(text, "f.yaml", TermSetError)
+    err = info.value
+    assert (err.span.line, err.span.column) == where
+    assert words in err.message and "indent" not in err.message + err.expected
+    assert expected in err.expected
+
+
+def test_a_tab_inside_a_world_files_value_through_the_cli(tmp_path, capsys):
+    from mitos_cli.cli.app import main
+
+    world = (Path(__file__).parent / "data" / "tiny.yaml").read_text()
+    (tmp_path / "w.yaml").write_text(world.replace("name: tiny", "name: ti\tny"))
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", str(tmp_path / "w.yaml")])
+    assert info.value.code == 1
+    assert capsys.readouterr().err.replace(str(tmp_path), "DIR") == (
+        "DIR/w.yaml:2:9: world error: invalid YAML: a tab inside a value, after `ti` (the YAML "
+        "reader takes no tab in a value that is not in quotes)\n"
+        "    name: ti    ny\n"
+        "            ^\n"
+        "expected a space in place of the tab, or the whole value in quotes (`\"...\"`, which "
+        "keeps the tab)\n")
 
 
 def test_no_mistake_in_a_world_file_shows_pyyamls_own_words():

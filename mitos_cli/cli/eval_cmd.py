@@ -377,17 +377,24 @@ def run_batch(rb: LoadedRuleBase, source: str, on_no_rule: NoRule | None = None,
     from ..engine.mamdani import undersampled
 
     if source == "-":                  # bytes: a text stream would turn `\r\n` into `\n`
+        from ..fileio import bad_byte, decode_text, text_encoding_hint, why_unreadable
+
         stream = getattr(sys.stdin, "buffer", None)
         try:
-            text = stream.read().decode("utf-8-sig") if stream is not None else sys.stdin.read()
+            text = decode_text(stream.read()) if stream is not None else sys.stdin.read()
         except UnicodeDecodeError as exc:
-            from ..fileio import bad_byte, why_unreadable
-
             raise InputError(f"cannot read the batch from stdin: {why_unreadable(exc)}",
-                             span=bad_byte("<stdin>", exc)) from None
+                             span=bad_byte("<stdin>", exc), hint=text_encoding_hint(exc)) from None
         name = "<stdin>"
     else:
-        from ..fileio import bad_byte, nearby, read_text, repository_only, unreadable
+        from ..fileio import (
+            bad_byte,
+            nearby,
+            read_text,
+            repository_only,
+            text_encoding_hint,
+            unreadable,
+        )
 
         try:
             text, name = read_text(source), source
@@ -395,7 +402,7 @@ def run_batch(rb: LoadedRuleBase, source: str, on_no_rule: NoRule | None = None,
             missing = isinstance(exc, FileNotFoundError)      # a mistyped name: did you mean
             raise InputError(unreadable("batch file", source, exc), span=bad_byte(source, exc),
                              hint=nearby(source, (".csv",)) or repository_only(source)
-                             if missing else None) from None
+                             if missing else text_encoding_hint(exc)) from None
     batch = read_table(text, name, rb.compiled.inputs, unused_inputs(rb))
     X = batch.X
     result = rb.run(X, strict=False, detail=False)

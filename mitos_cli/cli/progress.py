@@ -9,6 +9,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, cast
 
+from ..errors import Terminated
+
 if TYPE_CHECKING:
     from rich.console import Console
     from rich.progress import Progress, TaskID
@@ -88,17 +90,6 @@ def progress_bar(description: str, quiet: bool = False, lines: bool = False) -> 
                   TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(),
                   console=console, transient=True) as progress:
         yield Bar(progress, console, what=description)
-
-
-class Terminated(KeyboardInterrupt):
-    """A SIGTERM (``kill PID``, a batch scheduler's time limit) or a SIGHUP (the terminal
-    closed, an ssh session dropped) raised where the command is, as Ctrl-C raises
-    KeyboardInterrupt: what stops cleanly on one stops so on the others. ``code`` is the
-    exit code a shell expects of the signal (143, 129)."""
-
-    def __init__(self, code: int = TERMINATED) -> None:
-        super().__init__()
-        self.code = code
 
 
 def stopped_code(exc: BaseException) -> int:

@@ -81,10 +81,24 @@ def teach_command(
                        "printed; schema: `mitos docs teach`) instead of the transcript.")] = False,
 ) -> None:
     """Teach a rule base: tell rules and behaviors, correct outputs, adapt, save."""
+    from .progress import stopped_code, terminate_as_interrupt
+
+    _check_options(rules, behavior, lesson, save_as, resume, session_name, recover, as_json)
+    # a SIGTERM or a SIGHUP stops the session as Ctrl-C does (it ended by the signal's
+    # default, exit -15 or -1, without a word); the journal's writes hold all three
+    with terminate_as_interrupt():
+        try:
+            _teach(rules, behavior, lesson, save_as, resume, session_name, recover, as_json)
+        except KeyboardInterrupt as stop:       # (the words, where a session exists, said)
+            raise typer.Exit(stopped_code(stop)) from None
+
+
+def _teach(rules: str | None, behavior: str | None, lesson: str | None, save_as: str | None,
+           resume: bool, session_name: str | None, recover: bool, as_json: bool) -> None:
+    """The session opened or resumed, then its lesson run or its prompt read."""
     from ..teach.prompt import interact
     from .output import emit
 
-    _check_options(rules, behavior, lesson, save_as, resume, session_name, recover, as_json)
     transcript = Transcript() if as_json else None
     out = transcript.out if transcript is not None else emit      # what the session prints
     if resume:
@@ -258,11 +272,13 @@ def _ended_open(session: Session, text: str, name: str) -> None:
 def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | None,
                   transcript: Transcript | None) -> None:
     """Run a lesson file (or stdin) in ``session``; save where ``--save-as`` says if it ends
-    with changes unsaved. Ctrl-C keeps every change (the journal has them)."""
-    from ..errors import MitosError
+    with changes unsaved. Ctrl-C, a SIGTERM or a SIGHUP keeps every change (the journal has
+    them) and exits 130, 143 or 129."""
     from ..resources import packaged_name
-    from ..teach.lesson import read_lesson, run_lesson
+    from ..teach.journal import resume_command
+    from ..teach.lesson import read_lesson
     from .output import emit, err
+    from .progress import stopped_code
 
     text, found = lesson_text if lesson_text is not None else read_lesson(lesson)
     directory = session.journal.directory
@@ -273,17 +289,28 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
     # packaged rule base is, not by the path pip put it at
     name = packaged_name(found) or found if lesson != "-" else found
     try:
+        _run_and_save(session, text, name, transcript)
+    except KeyboardInterrupt as stop:    # in the save at the end too (it exited 130 unsaid)
+        err(f"interrupted: every change so far is in the journal; "
+            f"`{resume_command(directory)}` continues")
+        raise typer.Exit(stopped_code(stop)) from None
+    if transcript is not None:
+        emit(transcript.to_json(directory, session))
+
+
+def _run_and_save(session: Session, text: str, name: str, transcript: Transcript | None) -> None:
+    """The lesson's commands, then the save ``--save-as`` asks for."""
+    from ..errors import MitosError
+    from ..teach.lesson import run_lesson
+    from .output import err
+
+    directory = session.journal.directory
+    try:
         run_lesson(session, text, name)
     except MitosError:
         if session.journal.discard_if_unused():
             err(f"session {directory.name} removed: the lesson stopped before any change")
         raise
-    except KeyboardInterrupt:
-        from ..teach.journal import resume_command
-
-        err(f"interrupted: every change so far is in the journal; `{resume_command(directory)}` "
-            f"continues")
-        raise typer.Exit(130) from None
     if session.state.block is not None:
         _ended_open(session, text, name)
     if session.save_as is not None and session.unsaved:
@@ -299,5 +326,3 @@ def _teach_lesson(session: Session, lesson: str, lesson_text: tuple[str, str] | 
                             f"`{resume_command(directory)}`, then `save PATH` where you can "
                             f"write")
             raise
-    if transcript is not None:
-        emit(transcript.to_json(directory, session))

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..errors import FormatError, RuleBaseError
 from ..fileio import byte_span as _at
-from ..fileio import read_bytes, unreadable
+from ..fileio import not_text, read_bytes, text_encoding_hint, unreadable, wide_text
 from ..lang.model import RuleBase
 from ..lang.parse import check_rule_file_size
 from ..lang.resolve import rule_file_not_found_hint
@@ -44,6 +44,10 @@ def foreign_text(path: Path) -> tuple[str, str | None]:
     except OSError as exc:
         raise RuleBaseError(unreadable("rule file", path, exc),
                             hint=rule_file_not_found_hint(path)) from None
+    wide = wide_text(raw)               # UTF-16 or UTF-32: as every reader says it
+    if wide is not None:
+        raise FormatError(not_text(path, wide), span=_at(path, raw, wide.start),
+                          hint=text_encoding_hint(wide))
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -62,15 +66,9 @@ _MULTIBYTE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|"
 
 def _legacy(path: Path, head: bytes, exc: UnicodeDecodeError) -> str:
     """The text of ``path``, not UTF-8 (``exc``; ``head`` is its first bytes), as
-    Windows-1252, or why it is not that either: another Unicode encoding, a NUL, a file that
-    is UTF-8 elsewhere (read as Windows-1252, its UTF-8 would be garbled), a byte Windows-1252
-    leaves undefined."""
+    Windows-1252, or why it is not that either: a NUL, a file that is UTF-8 elsewhere (read as
+    Windows-1252, its UTF-8 would be garbled), a byte Windows-1252 leaves undefined."""
     data: bytes = exc.object            # (without a UTF-8 byte-order mark: the decoder drops it)
-    for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
-                      (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
-        if head.startswith(bom):
-            raise FormatError(f"`{path}` is {name} text; MITOS reads UTF-8 or Windows-1252",
-                              span=_at(path, data, 0), hint="save it as UTF-8")
     if b"\0" in data:
         raise _nul(path, data)
     utf8 = _MULTIBYTE.search(data)
@@ -88,12 +86,11 @@ def _legacy(path: Path, head: bytes, exc: UnicodeDecodeError) -> str:
 
 
 def _nul(path: Path, data: bytes) -> FormatError:
-    """The refusal of a file with a NUL byte in it (most often UTF-16 without its mark)."""
+    """The refusal of a file with a NUL byte in it that is not UTF-16 or UTF-32
+    (:func:`~mitos_cli.fileio.wide_text`: refused before)."""
     at = data.find(b"\0")
-    wide = len(data) >= 8 and data[:64].count(b"\0") >= min(len(data), 64) // 3
-    return FormatError(f"`{path}` is not a text file ({_byte(path, data, at)})"
-                       + (": it looks like UTF-16 text" if wide else ""),
-                       span=_at(path, data, at), hint="save it as UTF-8" if wide else None)
+    return FormatError(f"`{path}` is not a text file ({_byte(path, data, at)})",
+                       span=_at(path, data, at))
 
 
 def _byte(path: Path, data: bytes, start: int) -> str:

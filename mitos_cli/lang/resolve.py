@@ -69,15 +69,23 @@ def termset_hint(target: Path, name: str) -> str:
 @without_cyclic_gc
 def load_rules_file(path: str | Path) -> RuleBase:
     """Read, parse and check the rule file at ``path`` and the term sets it names."""
-    from ..fileio import bad_byte, broken_link, finish_saves, read_text, unreadable
+    from ..fileio import (
+        bad_byte,
+        broken_link,
+        finish_saves,
+        not_text,
+        read_text,
+        text_encoding_hint,
+        unreadable,
+    )
 
     path = Path(path)
     finish_saves(path)              # a set save a crash left half done
     try:
         text = read_text(path)
     except UnicodeDecodeError as exc:
-        raise RuleBaseError(f"`{path}` is not a text file (byte 0x{exc.object[exc.start]:02x} "
-                            "is not UTF-8)", span=bad_byte(path, exc)) from None
+        raise RuleBaseError(not_text(path, exc), span=bad_byte(path, exc),
+                            hint=text_encoding_hint(exc)) from None
     except OSError as exc:
         raise RuleBaseError(unreadable("rule file", path, exc),
                             hint=rule_file_not_found_hint(path)) from None

@@ -59,7 +59,7 @@ ALIASES = {"constant": "singleton"}     # Takagi-Sugeno's name for a crisp conse
 
 def load_termset(path: str | Path) -> TermSet:
     """Read and validate the term set at ``path``."""
-    from ..fileio import bad_byte, read_text, unreadable
+    from ..fileio import bad_byte, not_text, read_text, text_encoding_hint, unreadable
 
     path = Path(path)
     try:
@@ -67,8 +67,8 @@ def load_termset(path: str | Path) -> TermSet:
     except OSError as exc:
         raise TermSetError(unreadable("term set", path, exc)) from None
     except UnicodeDecodeError as exc:
-        raise TermSetError(f"`{path}` is not a text file (byte 0x{exc.object[exc.start]:02x} "
-                           "is not UTF-8)", span=bad_byte(path, exc)) from None
+        raise TermSetError(not_text(path, exc), span=bad_byte(path, exc),
+                           hint=text_encoding_hint(exc)) from None
     return parse_termset(text, str(path))
 
 

@@ -264,8 +264,8 @@ def load(text: str, path: str | None, error: type[MitosError]) -> Any:
         mark = (exc.context_mark if at_start else None) or exc.problem_mark or exc.context_mark
         span = _span(mark, text, path) if mark is not None else None
         problem, expected = _in_words(exc.problem or exc.context or "malformed YAML", exc.context)
-        if mark is not None and exc.problem == _TAB and _TRAILING.match(text, mark.index):
-            problem, expected = _TRAILING_TAB
+        if mark is not None and exc.problem == _TAB:
+            problem, expected = _tab_words(text, mark.index) or (problem, expected)
         hint = glued_hint(text, mark.line + 1) if mark is not None else None
         raise error(f"invalid YAML: {problem}", span=span, expected=expected, hint=hint) \
             from None
@@ -344,10 +344,50 @@ _TRAILING_TAB = ("a tab at the end of the line, after what it holds (the YAML re
                  "no tab there, though a space is fine)", "nothing after it on the line: delete "
                  "the tab, or make it a space")
 
+#: a tab after a key's `:`, a list item's `-` or a flow list's `[`, `{` or `,`: where the
+#: value starts (the indicator is the group)
+_BEFORE_VALUE = re.compile(r"(?:^|.*[^\s])(:)$|(?:^|.*\s)([-?])$|.*[\[{].*([\[{,])$")
+
+
+def _tab_words(text: str, at: int) -> tuple[str, str] | None:
+    """What a tab PyYAML refuses (``at``, "found character '\\t' that cannot start any
+    token") is, told by what stands before and after it on its line: at the line's end,
+    after what the line holds; where a value starts (after a key's `:`, an item's `-`); or
+    inside a value without quotes (`name: a<TAB>b`), which PyYAML said as a tab that YAML
+    does not take as indentation or to start a value, and sent the user to the indentation.
+    ``None`` in the indentation, which :data:`_WORDS` says (a tab between a key and its `:`
+    is said as such)."""
+    if _TRAILING.match(text, at):
+        return _TRAILING_TAB
+    start = max(text.rfind("\n", 0, at), text.rfind("\r", 0, at)) + 1
+    before = text[start:at].rstrip(" \t")
+    if not before:
+        return None
+    indicator = _BEFORE_VALUE.match(before)
+    if indicator is not None:
+        shown = next(g for g in indicator.groups() if g)
+        return (f"a tab after `{shown}`, where the value starts (the YAML reader takes no tab "
+                "there, though a space is fine)", "a space in place of the tab")
+    word = _LAST_WORD.search(before)
+    shown = word.group(0) if word is not None else before
+    if _KEY_AFTER.match(text, at):
+        return (f"a tab between the key `{shown}` and its `:`", "`key: value`, nothing between a "
+                "key and its `:`")
+    return (f"a tab inside a value, after `{shown}` (the YAML reader takes no tab in a value "
+            "that is not in quotes)", "a space in place of the tab, or the whole value in "
+            "quotes (`\"...\"`, which keeps the tab)")
+
+
+#: the word before a tab inside a value (not the `[`, `{` or `,` before it in a flow)
+_LAST_WORD = re.compile(r"[^\s\[{,]+$")
+#: a tab between a key and its `:`
+_KEY_AFTER = re.compile(r"\t[ \t]*:(?:[ \t\r\n]|$)")
+
+
 #: PyYAML's words for the mistakes people make most, and what YAML expected there
 _WORDS = {
     _TAB:
-        ("a tab, which YAML does not take as indentation or to start a value",
+        ("a tab in the indentation, which YAML does not take",
          "spaces: YAML indents with spaces only"),
     "mapping values are not allowed here":
         ("a `:` where no new key can start",

@@ -52,7 +52,8 @@ pose_heading_deg (the robot's heading, deg CCW from +x), speed (in/s), steering 
 straight), cmd_steering (deg), cmd_speed (in/s), clearance (in). ``pose_heading_deg`` is not
 the rule input ``heading`` (the route's bearing relative to the robot, positive right). The
 ``cmd_`` columns are the command after the robot's own brake and backing out (``safety.py``),
-not the planner's raw request (``mitos eval --batch`` on the rows gives that)."""
+held to its steering lock and top speeds (:class:`.loop.Tick`), not the planner's raw request
+(``mitos eval --batch`` on the rows gives that)."""
 
 
 def columns(beams: int) -> list[str]:

@@ -382,7 +382,7 @@ def _map_spec(path: Path, where: Span | None, written: str | None) -> yamlpos.YM
     """The map file's YAML mapping, its keys checked; an image named where the YAML goes, a
     pipe or a device, and a file that is no map_server map are refused (until the file is
     known to be a map file, an error quotes nothing of it: docs/security.md)."""
-    from ..fileio import bad_byte, named_yaml, read_text
+    from ..fileio import bad_byte, named_yaml, read_text, text_encoding_hint
 
     if path.suffix.lower() in IMAGE_SUFFIXES:        # the image named where its YAML goes
         beside = [p for p in (path.with_suffix(".yaml"), path.parent / "map.yaml") if exists(p)]
@@ -400,7 +400,8 @@ def _map_spec(path: Path, where: Span | None, written: str | None) -> yamlpos.YM
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldError(unreadable("map file", path, exc), span=bad_byte(path, exc) or where,
-                         hint=_beside(path, written, exc, (".yaml", ".yml"))
+                         hint=text_encoding_hint(exc)
+                         or _beside(path, written, exc, (".yaml", ".yml"))
                          or _packaged_map(written, exc)) from None
     named = named_yaml(path)
     try:

@@ -87,6 +87,24 @@ def _clip(x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.minimum(np.maximum(x, lo), hi)
 
 
+def command_bounds(lim: Limits) -> tuple[np.ndarray, np.ndarray]:
+    """The least and the greatest command each robot's drive takes, ``[n, 2]`` each
+    (steering deg, speed in/s): its steering lock, and its top speeds backward and forward.
+    :func:`step` turns the wheel and drives toward a command held to them."""
+    return (np.stack([lim.steering_min, 0.0 - lim.max_reverse], axis=1),  # (no reverse: 0, not -0)
+            np.stack([lim.steering_max, lim.max_speed], axis=1))
+
+
+def hold_commands(command: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> None:
+    """``command [n, 2]`` held in place to ``bounds`` (:func:`command_bounds`), as :func:`step`
+    holds it, so that :func:`step` from a held command moves as from the command itself. Only
+    a number past a bound is replaced: one within them is left as it is to the bit (NumPy's
+    ``maximum(0.0, -0.0)`` is ``-0.0``, and a speed of 0 for a robot with no reverse was
+    recorded as `-0`)."""
+    np.copyto(command, bounds[0], where=command < bounds[0])
+    np.copyto(command, bounds[1], where=command > bounds[1])
+
+
 def limit_commands(steering: np.ndarray, speed: np.ndarray, cmd_steering: np.ndarray,
                    cmd_speed: np.ndarray, lim: Limits, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """The steering and speed actually reached after ``dt`` given the commands: clamped to the

@@ -165,7 +165,7 @@ class SimResult:
     pose: np.ndarray               # [T, n, 3] x, y (in), heading (deg)
     speed: np.ndarray              # [T, n] in/s
     steering: np.ndarray           # [T, n] deg (the wheel's actual angle)
-    command: np.ndarray            # [T, n, 2] planner's steering and speed
+    command: np.ndarray            # [T, n, 2] steering, speed commanded (Tick.command)
     ranges: np.ndarray             # [T, n, B] in (noisy readings)
     perceived: dict[str, np.ndarray]   # name -> [T, n]
     clearance: np.ndarray          # [T, n] in, footprint to the nearest thing
@@ -364,7 +364,10 @@ class Tick:
     pose: np.ndarray                # [n, 3] x, y (in), heading (deg)
     speed: np.ndarray               # [n] in/s
     steering: np.ndarray            # [n] deg (the wheel's actual angle)
-    command: np.ndarray             # [n, 2] planner's steering and speed
+    #: [n, 2] steering (deg) and speed (in/s) commanded: the planner's (or step()'s), as the
+    #: robot's own safety left them, held to its steering lock and top speeds (the drive
+    #: takes no more; kinematics.hold_commands); before the rate and acceleration limits
+    command: np.ndarray
     ranges: np.ndarray              # [n, B] in (noisy readings)
     block: np.ndarray = field(repr=False)   # [inputs, n]: the perceived rule inputs, a row each
     clearance: np.ndarray           # [n] in
@@ -566,6 +569,7 @@ class Simulation:
         self.robots = [a.robot for a in world.agents]
         self.n = len(self.robots)
         self.limits = kinematics.Limits.of(self.robots)
+        self._bounds = kinematics.command_bounds(self.limits)
         sen = world.sensors
         self.angles = sen.angles
         beams = len(self.angles)
@@ -856,7 +860,9 @@ class Simulation:
 
     def verdict(self, s: _Sensed) -> tuple[Tick, bool]:
         """The end of :meth:`decide`, once the guard has had its say on ``s``'s commands:
-        the tick recorded and the verdict."""
+        the commands held to the robots' limits (:func:`.kinematics.hold_commands`), the tick
+        recorded and the verdict."""
+        kinematics.hold_commands(s.command, self._bounds)
         tick = self._record(s)
         return tick, self._judge(s, bool(np.count_nonzero(self._hit)),
                                  bool(np.count_nonzero(self._active)))
@@ -1711,6 +1717,8 @@ class Batch:
         # batch's last moves
         self._active, self._recovery = self._share("_active"), self._share("_recovery")
         self._straight = np.concatenate([run.limits.straight for run in runs])
+        self._bounds = (np.concatenate([run._bounds[0] for run in runs]),
+                        np.concatenate([run._bounds[1] for run in runs]))
         self._lengths = self._share("_lengths")
         self._trail: list[tuple[np.ndarray, np.ndarray]] = []
         self.stacked: rows.Kept = {}        # what its last rows.sense stacked of the runs' rows
@@ -2097,6 +2105,7 @@ class Batch:
         tick's fields written into a page of the batch's :class:`_Book`, each run's tick
         recorded (views of its rows) and judged; the runs whose robots move now (:attr:`runs`
         itself where all of them do)."""
+        kinematics.hold_commands(self.command, self._bounds)    # (as each run's verdict)
         book, i = self._page()
         x, y, h = self._ticked()
         pose = book.pose[i]

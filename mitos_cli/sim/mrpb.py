@@ -41,7 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MitosError, Span, WorldError
-from ..fileio import bad_byte, unreadable
+from ..fileio import bad_byte, read_text, text_encoding_hint, unreadable
 from .gridmap import INCH_PER_M, load_map_yaml
 from .loop import prepare
 from .world import Agent, Goal, Pose, Randomise, Robot, Sensors, World
@@ -65,9 +65,10 @@ def read_tests(path: Path) -> list[tuple[int, Pose, Pose]]:
     """The tests of a ``tests.txt``: (number, start, goal) with poses in inches and degrees.
     A byte-order mark (a Windows editor's) is read past, as a world file's is."""
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(unreadable("MRPB tests", path, exc), span=bad_byte(path, exc)) from None
+        raise WorldError(unreadable("MRPB tests", path, exc), span=bad_byte(path, exc),
+                         hint=text_encoding_hint(exc)) from None
     out = []
     for i, line in enumerate(text.splitlines(), 1):
         if not line.strip() or line.lstrip().startswith("#"):

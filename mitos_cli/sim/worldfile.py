@@ -1578,7 +1578,7 @@ def load_world(path: str | Path) -> World:
     packaged world (``figure4``, ``worlds/figure4.yaml``) reads the packaged one, as the
     command line and the Gymnasium environments do, so the documented calls work from any
     directory; anything else is an :class:`UnknownWorld` with the packaged names."""
-    from ..fileio import bad_byte, named_yaml, read_text, unreadable
+    from ..fileio import bad_byte, named_yaml, read_text, text_encoding_hint, unreadable
     from ..resources import is_file
 
     path = Path(_world_path_given(path))
@@ -1587,7 +1587,8 @@ def load_world(path: str | Path) -> World:
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        raise WorldError(unreadable("world file", path, exc), span=bad_byte(path, exc)) from None
+        raise WorldError(unreadable("world file", path, exc), span=bad_byte(path, exc),
+                         hint=text_encoding_hint(exc)) from None
     if not named_yaml(path):
         # Until the file is known to be a world, an error quotes nothing of it (a lesson may
         # name any file; docs/security.md).

@@ -1110,6 +1110,10 @@ class Adaptation:
     converged: bool
     interrupted: bool = False
     rounded: bool = False            # the last entry of ``history`` is Q after rounding
+    #: what stopped it when ``interrupted``: a Ctrl-C's KeyboardInterrupt, or a SIGTERM's or
+    #: SIGHUP's :class:`~mitos_cli.errors.Terminated`, which the caller raises again once the
+    #: epochs done are kept (a lesson stops, and the prompt ends, with the signal's code)
+    stopped_by: KeyboardInterrupt | None = None
 
     @property
     def q_before(self) -> float:
@@ -1389,7 +1393,7 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
     compass = _Compass.of(p, rate)       # polls the free directions where the step stalls
     polling = False
     converged = False
-    interrupted = False
+    stopped_by: KeyboardInterrupt | None = None
     try:
         for epoch in range(1, epochs + 1):
             if Q <= 0.0:
@@ -1419,14 +1423,15 @@ def adapt(compiled: CompiledRuleBase, X: np.ndarray, targets: np.ndarray, *, epo
             if on_values is not None:
                 on_values(values)
             step = min(1.0, step * 2.0)
-    except KeyboardInterrupt:
-        interrupted = True            # keep what the completed epochs learned
+    except KeyboardInterrupt as stop:   # (a SIGTERM, a SIGHUP too: Terminated)
+        stopped_by = stop             # keep what the completed epochs learned
     q_learned = history[-1]
     values, q_final = _round(p, values, X, targets, history[0], q_learned)
     rounded = q_final != q_learned
     if rounded:
         history.append(q_final)
-    return Adaptation(p, values, tuple(history), converged, interrupted, rounded)
+    return Adaptation(p, values, tuple(history), converged, stopped_by is not None, rounded,
+                      stopped_by)
 
 
 def _round(p: Parameters, values: np.ndarray, X: np.ndarray, targets: np.ndarray,

@@ -249,26 +249,52 @@ class Journal:
         return [e for e in entries if e["seq"] not in undone and e["op"] not in RECORDS]
 
 
+#: The signals held while the journal is written and while a save is journaled: Ctrl-C, and
+#: the two that `mitos teach` answers as it (SIGHUP: not on Windows).
+HELD = ("SIGINT", "SIGTERM", "SIGHUP")
+
+
 @contextlib.contextmanager
 def held_interrupt() -> Iterator[None]:
-    """Hold a Ctrl-C (SIGINT) until the block ends, then raise it: one during the journal's
-    fsync (the longest part of a change) was raised after the line was on disk and before
-    the session counted it, so the next change was numbered alike and the journal was
-    damaged there. (Only the main thread may set a handler: elsewhere, as before.)"""
-    if threading.current_thread() is not threading.main_thread() \
-            or signal.getsignal(signal.SIGINT) is None:      # (a handler set outside Python)
+    """Hold a Ctrl-C (SIGINT), a SIGTERM or a SIGHUP until the block ends, then deliver it:
+    one during the journal's fsync (the longest part of a change) was raised after the line
+    was on disk and before the session counted it, so the next change was numbered alike and
+    the journal was damaged there. SIGTERM and SIGHUP stop `mitos teach` as Ctrl-C does
+    (:class:`~mitos_cli.errors.Terminated`), so they are held alike; one whose handler is the
+    system's default ends the process once the block is done, as the signal does. (Only the
+    main thread may set a handler: elsewhere, as before; an ignored signal, or one whose
+    handler was set outside Python, is left alone.)"""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
     caught: list[tuple] = []
-    old = signal.signal(signal.SIGINT, lambda *args: caught.append(args))
+    previous = {}
+    for name in HELD:
+        number = getattr(signal, name, None)
+        if number is None:
+            continue
+        handler = signal.getsignal(number)
+        if handler is None or handler == signal.SIG_IGN:
+            continue
+        previous[number] = signal.signal(number, lambda *args: caught.append(args))
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, old)
-        if caught and callable(old):
-            old(*caught[0])                       # Python's: raises KeyboardInterrupt
-        elif caught and old != signal.SIG_IGN:
-            raise KeyboardInterrupt
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        if caught:
+            _deliver(caught[0], previous[caught[0][0]])
+
+
+def _deliver(caught: tuple, handler: object) -> None:
+    """A signal held by :func:`held_interrupt`, given to the handler it was held from."""
+    signum = caught[0]
+    if callable(handler):
+        handler(*caught)                      # Python's for SIGINT: raises KeyboardInterrupt
+    elif signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    else:
+        signal.raise_signal(signum)           # the default: the process ends as by the signal
 
 
 def _unused(path: Path) -> Path:

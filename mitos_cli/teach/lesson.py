@@ -73,7 +73,9 @@ def check_lesson_size(text: str, path: str) -> None:
 
 def run_lesson(session: Session, text: str, path: str) -> bool:
     """Run every command of ``text``; False when the lesson said ``quit``. Ctrl-C stops the
-    lesson (``KeyboardInterrupt``), also when an ``adapt`` caught it to keep its epochs. Its
+    lesson (``KeyboardInterrupt``; a SIGTERM or a SIGHUP, where the CLI answers them, its
+    :class:`~mitos_cli.errors.Terminated`), also when an ``adapt`` caught it to keep its
+    epochs. Its
     ``save PATH`` stays below the working directory (:attr:`Session.confined`). A lesson past
     the limits (:func:`check_lesson_size`) is refused before it runs."""
     check_lesson_size(text, path)
@@ -87,13 +89,13 @@ def run_lesson(session: Session, text: str, path: str) -> bool:
 def _run(session: Session, text: str, path: str) -> bool:
     for lineno, line in commands(text):
         session.echo(f"{path}:{lineno}> {visible(line.splitlines()[0])}")
-        session.interrupted = False
+        session.interrupted = None
         was_open = session.state.block
         try:
             if not session.run(line, path, lineno):
                 return False
             if session.interrupted:         # Ctrl-C in an `adapt`: what it learned is kept
-                raise KeyboardInterrupt     # (journaled); the rest of the lesson is not run
+                raise session.interrupted   # (journaled); the rest of the lesson is not run
             if session.state.block != was_open:     # where it opened, for the lesson's end
                 session.opened_at = None if session.state.block is None else Span.in_text(
                     "\n" * (lineno - 1) + line, path, lineno, len(line) - len(line.lstrip()) + 1)
@@ -159,13 +161,13 @@ def _read_stdin() -> str:
     data = buffer.read(limit)
     if len(data) >= limit:              # past the limit whatever it holds: said by its size
         return data.decode("utf-8-sig", errors="replace")
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        from ..fileio import bad_byte, unreadable
+    from ..fileio import bad_byte, decode_text, text_encoding_hint, unreadable
 
-        raise LessonError(unreadable("lesson", "<stdin>", exc),
-                          span=bad_byte("<stdin>", exc)) from None
+    try:
+        return decode_text(data)
+    except UnicodeDecodeError as exc:
+        raise LessonError(unreadable("lesson", "<stdin>", exc), span=bad_byte("<stdin>", exc),
+                          hint=text_encoding_hint(exc)) from None
 
 
 def read_lesson(source: str) -> tuple[str, str]:
@@ -181,12 +183,13 @@ def read_lesson(source: str) -> tuple[str, str]:
         found = resolve("rulebases/lessons", source, ".lesson")
         if found is not None:
             path, source = found, str(found)
-    from ..fileio import bad_byte, broken_link, read_text, unreadable
+    from ..fileio import bad_byte, broken_link, read_text, text_encoding_hint, unreadable
 
     try:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
-        error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc))
+        error = LessonError(unreadable("lesson", source, exc), span=bad_byte(source, exc),
+                            hint=text_encoding_hint(exc))
         if isinstance(exc, FileNotFoundError) and broken_link("lesson", path) is None:
             # a mistyped name: a lesson file beside it, else the packaged lessons
             from ..errors import did_you_mean

@@ -6,7 +6,9 @@ and tab completion of command words, variable names, term names, behavior names 
 labels; no extra dependency. Without a terminal (a pipe) the prompt reads plain lines, which is
 how the tests drive it. A mistyped line prints what was expected and the prompt goes on;
 Ctrl-C cancels the line (or stops an adaptation, keeping the epochs done); Ctrl-D or ``quit``
-leaves, and everything told is already in the journal.
+leaves, and everything told is already in the journal. A SIGTERM or a SIGHUP, which the CLI
+raises as :class:`~mitos_cli.errors.Terminated`, ends the prompt where Ctrl-C would have
+gone on (an adaptation keeps its epochs done first).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..errors import LessonError, MitosError, Span
+from ..errors import LessonError, MitosError, Span, Terminated
 from ..fuzzy.hedges import HEDGES
 from .commands import COMMAND_WORDS, SHOW_WHAT, incomplete
 from .instructions import HEDGE_STEPS, INSTRUCTIONS
@@ -249,6 +251,7 @@ def interact(session: Session, history: Path | None = None) -> None:
             if bad is not None:
                 print(bad.render(), file=err)
                 continue
+            session.interrupted = None
             try:                                 # Ctrl-C anywhere here keeps the session
                 if readline is not None and history is not None:
                     with contextlib.suppress(OSError, AttributeError):
@@ -257,13 +260,21 @@ def interact(session: Session, history: Path | None = None) -> None:
                     break
             except MitosError as exc:
                 print(at_prompt(exc, line, lineno).render(), file=err)
+            except Terminated:
+                raise
             except KeyboardInterrupt:
                 session.replay()            # the state is exactly what the journal holds
                 print("interrupted", file=err)
+            if isinstance(session.interrupted, Terminated):
+                raise session.interrupted   # an `adapt` kept its epochs done (journaled)
             sys.stdout.flush()
             if ended:
                 session.out("")
                 break
+    except Terminated:                      # the session ends; the caller exits 143 or 129
+        session.replay(checked=False)       # the state is exactly what the journal holds
+        print("interrupted", file=err)
+        raise
     finally:
         _farewell(session, err)
 
@@ -292,6 +303,8 @@ def _statements(session: Session, tty: bool, err: TextIO) -> Iterator[tuple[str,
         except EOFError:
             session.out("")
             return
+        except Terminated:
+            raise
         except KeyboardInterrupt:
             print("^C  (the line is dropped; `quit` or Ctrl-D leaves)", file=err)
             continue

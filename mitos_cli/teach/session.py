@@ -187,7 +187,9 @@ class Session:
         #: lesson may come from anyone, and its `save /any/where.rules` wrote over that file
         self.confined: Path | None = None
         self.saved_seq = 0
-        self.interrupted = False            # the last command's adaptation was cut short
+        #: what cut the last command's adaptation short (Ctrl-C, or a SIGTERM's or SIGHUP's
+        #: Terminated), to be raised again once what it learned is journaled
+        self.interrupted: KeyboardInterrupt | None = None
         self.opened_at: Span | None = None  # where a lesson opened the behavior still open
         self.state = State(self.original, active)
         self._indexes: dict[str, _RuleIndex] = {}
@@ -548,10 +550,13 @@ class Session:
         return exc
 
     def _term_refs(self, refs: Iterable[Sequence[str]]) -> list[list[str]]:
+        """The terms ``refs`` (``frozen``, ``unfrozen``) names, checked: an unknown variable is
+        a name error, as an unknown term or rule label is (it was a lesson error, a "command
+        error" at the prompt), with its "did you mean"."""
         variables = self.rulebase.variables
         for var, term in refs:
             if var not in variables:
-                raise unknown("variable", var, list(variables), cls=LessonError)
+                raise unknown("variable", var, list(variables))
             variables[var].term(term)                    # unknown term: did you mean
         return [list(r) for r in refs]
 
@@ -908,7 +913,8 @@ class Session:
                               hint="adapt again to go on from where it stopped")
         rate = DEFAULT_RATE if c.rate is None else c.rate
         result = self._learn(c, compiled, X, T, epochs, rate)
-        self.interrupted = result.interrupted
+        self.interrupted = result.stopped_by or (KeyboardInterrupt() if result.interrupted
+                                                 else None)
         before = self.rulebase
         terms, crisp = learned_changes(before, learned_rulebase(result.parameters,
                                                                 result.values))
