@@ -905,3 +905,24 @@ def test_an_output_without_aggregation_does_not_borrow_another_outputs():
         "then Power is LOW", "then Power is LOW and Fan is OFF")
     with pytest.raises(MitosError, match="output `Fan` has no aggregation, but rules r1 and r2"):
         parse_fll(text, "f.fll")
+
+
+# ---------------------------------------------------------------------------------------------
+# Found on public files (night 25)
+
+def test_fis_names_written_with_blanks_around_them_are_read_without(tmp_path):
+    """`Name='User '` and `MF1='Low '` (in public MATLAB files) were read with the blank:
+    a batch CSV's header cells are trimmed, so `--batch` could never name that input ("no
+    column for `User `"). fuzzylite trims them too; MITOS now reads `User` and `Low`."""
+    text = TIPPER_FIS.replace("Name='food'", "Name='food '").replace(
+        "MF1='rancid'", "MF1=' rancid  '")
+    rb = parse_fis(text, "t.fis")
+    assert "food" in rb.variables and [t.name for t in rb.variables["food"].terms] == [
+        "rancid", "delicious"]
+    path = tmp_path / "t.fis"
+    path.write_text(text)
+    result = runner.invoke(app, ["eval", str(path), "--batch", "-"],
+                           input="service,food\n2,1\n")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[0] == "service,food,tip"
+    assert float(result.stdout.splitlines()[1].split(",")[2]) == pytest.approx(7.016879, abs=1e-6)
