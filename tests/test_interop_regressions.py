@@ -926,3 +926,62 @@ def test_fis_names_written_with_blanks_around_them_are_read_without(tmp_path):
     assert result.exit_code == 0, result.output
     assert result.stdout.splitlines()[0] == "service,food,tip"
     assert float(result.stdout.splitlines()[1].split(",")[2]) == pytest.approx(7.016879, abs=1e-6)
+
+
+COGS_NO_RANGE = """\
+FUNCTION_BLOCK score
+VAR_INPUT
+    x : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    TERM lo := (0, 1) (4, 0);
+    TERM hi := (6, 0) (10, 1);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM low := 10;
+    TERM high := 100;
+    METHOD : COGS;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    ACCU : MAX;
+    RULE 1 : IF x IS lo THEN y IS low;
+    RULE 2 : IF x IS hi THEN y IS high;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fcl_cogs_default_beyond_the_singletons_widens_the_range_it_derives():
+    """An output without RANGE gets its terms' extent, [10, 100] here, as jFuzzyLogic derives
+    it; `DEFAULT := 0` (returned where no rule fires) was then refused as outside "its range",
+    a range the file never wrote. COGS averages the singletons and samples no range, so the
+    range now holds the default, as it already did for linear (COGF) terms: 10 at x = 2, 0
+    where no rule fires, 100 at x = 9, the same numbers as with `RANGE := (0 .. 100)`."""
+    rb = parse_fcl(COGS_NO_RANGE, "s.fcl")
+    assert rb.variables["y"].universe == (0.0, 100.0)
+    assert any("`y` has no RANGE; its universe [0, 100] holds its terms' values and its "
+               "DEFAULT 0" in n for n in rb.notes)
+    written = parse_fcl(COGS_NO_RANGE.replace("    DEFAULT := 0;\n",
+                                              "    DEFAULT := 0;\n    RANGE := (0 .. 100);\n"),
+                        "r.fcl")
+    for x, want in [(2.0, 10.0), (5.0, 0.0), (9.0, 100.0), (3.0, 10.0)]:
+        assert outputs(rb, x=x)["y"] == want == outputs(written, x=x)["y"]
+
+
+def test_fcl_sampled_output_default_beyond_its_derived_range_says_the_range_was_derived():
+    """Under COG the derived range is sampled, so widening it would move the numbers from
+    jFuzzyLogic's; the refusal now says that the file gives no RANGE and which one to add."""
+    text = COGS_NO_RANGE.replace("TERM low := 10;", "TERM low := (10, 0) (20, 1) (30, 0);") \
+        .replace("TERM high := 100;", "TERM high := (70, 0) (80, 1) (100, 0);") \
+        .replace("METHOD : COGS;", "METHOD : COG;")
+    with pytest.raises(MitosError) as exc:
+        parse_fcl(text, "c.fcl")
+    assert exc.value.message.startswith("output `y` has no RANGE, and its DEFAULT 0 lies outside "
+                                        "[10, 100], the extent of its terms")
+    assert exc.value.hint.startswith("add `RANGE := (0 .. 100);`")
+    assert exc.value.span is not None and exc.value.span.line == 16
