@@ -233,6 +233,8 @@ def _glued_error(glued: Glued, text: str, path: str | None) -> FormatError:
 
 def _expected(terminals: set[str]) -> str | None:
     words = sorted({_word(e) for e in terminals})
+    if len(words) == 1:
+        return words[0]                       # "a name", not "one of a name"
     return ("one of " + ", ".join(words)) if words else None
 
 
