@@ -985,3 +985,55 @@ def test_fcl_sampled_output_default_beyond_its_derived_range_says_the_range_was_
                                         "[10, 100], the extent of its terms")
     assert exc.value.hint.startswith("add `RANGE := (0 .. 100);`")
     assert exc.value.span is not None and exc.value.span.line == 16
+
+
+SUGENO_CONSTANT_FIS = """\
+[System]
+Name='s'
+Type='sugeno'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='prod'
+OrMethod='probor'
+ImpMethod='prod'
+AggMethod='sum'
+DefuzzMethod='wtaver'
+
+[Input1]
+Name='t'
+Range=[24 34]
+NumMFs=2
+MF1='cool':'trimf',[14 24 34]
+MF2='warm':'trimf',[24 34 44]
+
+[Output1]
+Name='fan'
+Range=[0 1]
+NumMFs=2
+MF1='slow':'linear',[-0.01 0.5]
+MF2='full':'linear',[0 100]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+def test_a_constant_linear_term_beyond_the_range_converts_to_rules(tmp_path):
+    """A public Sugeno file writes `linear [0 0 100]` on `Range=[0 1]` (MATLAB's Sugeno ranges
+    bound nothing). The rule-language writer wrote it as the number 100, which a term set
+    refuses beyond the universe, and `convert --to rules` stopped with "a defect of `mitos
+    convert`; please report it". A constant linear term beyond the universe stays linear."""
+    src = tmp_path / "s.fis"
+    src.write_text(SUGENO_CONSTANT_FIS)
+    out = tmp_path / "s.rules"
+    result = runner.invoke(app, ["convert", str(src), "--to", "rules", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    terms = (tmp_path / "s.terms.yaml").read_text()
+    assert "full: {shape: linear, coefficients: {}, constant: 100}" in terms
+    X = np.linspace(24, 34, 41)
+    before = load_rulebase(src).evaluate(t=X)["fan"]
+    after = load_rulebase(out).evaluate(t=X)["fan"]
+    np.testing.assert_array_equal(after, before)
+    assert before[-1] == 100.0 and before[0] == pytest.approx(0.26, abs=1e-12)
