@@ -630,7 +630,7 @@ def test_a_default_nan_against_a_number_is_told_as_such_not_as_inf(tmp_path: Pat
     assert not any("inf" in n.split("(")[0] for n in notes), notes
     told = [n for n in notes if "where the rule base gives nan" in n]
     assert len(told) == 1 and "`y` is 5 where the rule base gives nan, on " in told[0]
-    assert " of 2,000 seeded inputs (first at x=" in told[0]
+    assert " of 2,000 seeded inputs and 3 at the universes' ends and middles (first at x=" in told[0]
 
 
 def test_fidelity_chooses_the_reference_engines_sampling():
@@ -1037,3 +1037,54 @@ def test_a_constant_linear_term_beyond_the_range_converts_to_rules(tmp_path):
     after = load_rulebase(out).evaluate(t=X)["fan"]
     np.testing.assert_array_equal(after, before)
     assert before[-1] == 100.0 and before[0] == pytest.approx(0.26, abs=1e-12)
+
+
+POINT_FIS = """\
+[System]
+Name='point'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='centroid'
+
+[Input1]
+Name='tutor'
+Range=[0 1]
+NumMFs=2
+MF1='no':'trimf',[0 0 0]
+MF2='yes':'trimf',[1 1 1]
+
+[Output1]
+Name='grade'
+Range=[0 30]
+NumMFs=2
+MF1='low':'trimf',[0 0 7]
+MF2='high':'trimf',[23 30 30]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+def test_convert_measures_at_the_universes_ends_where_a_term_is_one_point(tmp_path):
+    """A public file's 0/1 inputs have `trimf [0 0 0]` and `[1 1 1]` terms, 1 at one point,
+    which none of 2,000 draws meets: `convert --to fll` measured no difference and gave no
+    figure, while at tutor = 0 and 1 the written FLL's output moves (101 end points against
+    1000 midpoints). The ends and middles of the universes are measured too."""
+    src = tmp_path / "p.fis"
+    src.write_text(POINT_FIS)
+    result = runner.invoke(app, ["convert", str(src), "--to", "fll", "-o", str(tmp_path / "p.fll")])
+    assert result.exit_code == 0, result.output
+    moved = [line for line in result.stderr.splitlines() if "`grade` moves by up to" in line]
+    assert len(moved) == 1, result.stderr
+    assert moved[0].endswith("on 2,000 seeded inputs and 3 at the universes' ends and middles "
+                             "(largest at tutor=0)") or moved[0].endswith("(largest at tutor=1)")
+    before = load_rulebase(src).evaluate(tutor=np.array([0.0, 0.5, 1.0]))["grade"]
+    after = load_rulebase(tmp_path / "p.fll").evaluate(tutor=np.array([0.0, 0.5, 1.0]))["grade"]
+    assert before[1] == after[1] == 15.0 and before[0] != after[0]
