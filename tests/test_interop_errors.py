@@ -134,21 +134,21 @@ def test_fll_errors(old: str, new: str, words: str) -> None:
 # A rule's keyword glued to the next word: the contextual lexer took it off the word's front
 # (`a islow` was `a is low`); fuzzylite splits a rule at its blanks and refuses the word.
 @pytest.mark.parametrize("old, new, word, expected, hint", [
-    ("if a is low and", "if a islow and", "islow", "one of is",
+    ("if a is low and", "if a islow and", "islow", "is",
      "`is` and `low` are two words: `is low`"),
     ("is small then y", "is small theny", "theny", "one of and, or, then",
      "`then` and `y` are two words: `then y`"),
     ("is on with 0.5", "is on with0.5", "with0.5", "one of and, the end of the rule, with",
      "`with` and `0.5` are two words: `with 0.5`"),
-    ("rule: if a is low", "rule: ifa is low", "ifa", "one of if",
+    ("rule: if a is low", "rule: ifa is low", "ifa", "if",
      "`if` and `a` are two words: `if a`"),
     ("is low and b", "is low andb", "andb", "one of and, or, then",
      "`and` and `b` are two words: `and b`"),
     ("is high or b", "is high orb", "orb", "one of and, or, then",
      "`or` and `b` are two words: `or b`"),
-    ("if a is low and", "if a isvery low and", "isvery", "one of is",
+    ("if a is low and", "if a isvery low and", "isvery", "is",
      "`is` and `very` are two words: `is very`"),
-    ("with 0.5", "with 0.5x", "0.5x", "one of a number", None),
+    ("with 0.5", "with 0.5x", "0.5x", "a number", None),
 ])
 def test_fll_a_keyword_glued_to_the_next_word_is_refused_at_the_word(
         old: str, new: str, word: str, expected: str, hint: str | None) -> None:
@@ -173,7 +173,7 @@ def test_fll_a_term_glued_to_a_keyword_is_named_in_the_hint() -> None:
         "hint: `onwith` is read as one name: `on` and `with` are two words")
     with pytest.raises(FormatError) as info:       # the end of the rule said after it
         parse_fll(fll("then y is on with 0.5", "then y is on with"), "bad.fll")
-    assert (info.value.span.column, info.value.expected) == (51, "one of a number")
+    assert (info.value.span.column, info.value.expected) == (51, "a number")
 
 
 def test_fll_a_term_name_glued_to_its_type_is_named_in_the_hint() -> None:
@@ -419,13 +419,13 @@ def test_fcl_keywords_as_fcl_writes_them(old: str, new: str, at: str, hint: str 
      "`IS` and `good` are two words: `IS good`"),
     ("IS good THEN tip", "IS good THENtip", "THENtip", "one of AND, OR, THEN",
      "`THEN` and `tip` are two words: `THEN tip`"),
-    ("RULE 2 : IF service", "RULE 2 : IFservice", "IFservice", "one of IF",
+    ("RULE 2 : IF service", "RULE 2 : IFservice", "IFservice", "IF",
      "`IF` and `service` are two words: `IF service`"),
     ("IS poor OR food", "IS poor ORfood", "ORfood", "one of AND, OR, THEN",
      "`OR` and `food` are two words: `OR food`"),
     ("IS excellent AND food", "IS excellent ANDfood", "ANDfood", "one of AND, OR, THEN",
      "`AND` and `food` are two words: `AND food`"),
-    ("IF NOT (", "IFNOT (", "IFNOT", "one of IF", "`IF` and `NOT` are two words: `IF NOT`"),
+    ("IF NOT (", "IFNOT (", "IFNOT", "IF", "`IF` and `NOT` are two words: `IF NOT`"),
     ("service IS NOT excellent", "service ISNOT excellent", "ISNOT", "one of AND, IS, OR, THEN",
      "`IS` and `NOT` are two words: `IS NOT`"),
     ("WITH 0.8", "WITH0.8", "WITH0.8",
@@ -442,7 +442,7 @@ def test_fcl_keywords_as_fcl_writes_them(old: str, new: str, at: str, hint: str 
      "FUZZIFY, RULEBLOCK, VAR_INPUT, VAR_OUTPUT", "`RULEBLOCK` and `No1` are two words: "
      "`RULEBLOCK No1`"),
     ("FUNCTION_BLOCK tipper", "FUNCTION_BLOCKtipper", "FUNCTION_BLOCKtipper",
-     "one of FUNCTION_BLOCK", "`FUNCTION_BLOCK` and `tipper` are two words: "
+     "FUNCTION_BLOCK", "`FUNCTION_BLOCK` and `tipper` are two words: "
      "`FUNCTION_BLOCK tipper`"),
     ("END_FUZZIFY\n\nDEFUZZIFY", "END_FUZZIFYDEFUZZIFY", "END_FUZZIFYDEFUZZIFY",
      "one of END_FUZZIFY, METHOD/ACCU/AND/OR/ACT, RANGE, TERM",
@@ -554,7 +554,7 @@ def test_fcl_a_keyword_split_in_two_is_said_as_one_word(old: str, new: str, at: 
 def test_fcl_punctuation_is_quoted() -> None:
     with pytest.raises(FormatError) as info:
         parse_fcl(FCL.replace("TERM poor :=", "TERM poor =", 1), "bad.fcl")
-    assert info.value.expected == "one of `:=`"
+    assert info.value.expected == "`:=`"
 
 
 def test_fcl_sugeno_lock_range() -> None:
@@ -738,3 +738,15 @@ def test_bytes_that_are_no_text_are_refused_where_they_are(tmp_path: Path, data:
         read_foreign(tmp_path / "x.fis")
     assert exc.value.span is not None
     assert (exc.value.span.line, exc.value.span.column) == at
+
+
+def test_one_thing_expected_is_named_without_one_of() -> None:
+    """A consequent in parentheses (`THEN (tip IS cheap)`, which jFuzzyLogic's grammar does not
+    have; a public file writes it) said "expected one of a name"; one word expected is named
+    alone, in FCL and FLL alike."""
+    with pytest.raises(FormatError) as info:
+        parse_fcl(FCL.replace("THEN tip IS cheap", "THEN (tip IS cheap)", 1), "bad.fcl")
+    assert (info.value.message, info.value.expected) == ("unexpected `(`", "a name")
+    with pytest.raises(FormatError) as info:
+        parse_fll(fll("then y is on with 0.5", "then y is on with"), "bad.fll")
+    assert info.value.render().splitlines()[-1] == "expected a number"

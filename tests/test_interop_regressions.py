@@ -630,7 +630,7 @@ def test_a_default_nan_against_a_number_is_told_as_such_not_as_inf(tmp_path: Pat
     assert not any("inf" in n.split("(")[0] for n in notes), notes
     told = [n for n in notes if "where the rule base gives nan" in n]
     assert len(told) == 1 and "`y` is 5 where the rule base gives nan, on " in told[0]
-    assert " of 2,000 seeded inputs (first at x=" in told[0]
+    assert " of 2,000 seeded inputs and 3 at the universes' ends and middles (first at x=" in told[0]
 
 
 def test_fidelity_chooses_the_reference_engines_sampling():
@@ -905,3 +905,186 @@ def test_an_output_without_aggregation_does_not_borrow_another_outputs():
         "then Power is LOW", "then Power is LOW and Fan is OFF")
     with pytest.raises(MitosError, match="output `Fan` has no aggregation, but rules r1 and r2"):
         parse_fll(text, "f.fll")
+
+
+# ---------------------------------------------------------------------------------------------
+# Found on public files (night 25)
+
+def test_fis_names_written_with_blanks_around_them_are_read_without(tmp_path):
+    """`Name='User '` and `MF1='Low '` (in public MATLAB files) were read with the blank:
+    a batch CSV's header cells are trimmed, so `--batch` could never name that input ("no
+    column for `User `"). fuzzylite trims them too; MITOS now reads `User` and `Low`."""
+    text = TIPPER_FIS.replace("Name='food'", "Name='food '").replace(
+        "MF1='rancid'", "MF1=' rancid  '")
+    rb = parse_fis(text, "t.fis")
+    assert "food" in rb.variables and [t.name for t in rb.variables["food"].terms] == [
+        "rancid", "delicious"]
+    path = tmp_path / "t.fis"
+    path.write_text(text)
+    result = runner.invoke(app, ["eval", str(path), "--batch", "-"],
+                           input="service,food\n2,1\n")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[0] == "service,food,tip"
+    assert float(result.stdout.splitlines()[1].split(",")[2]) == pytest.approx(7.016879, abs=1e-6)
+
+
+COGS_NO_RANGE = """\
+FUNCTION_BLOCK score
+VAR_INPUT
+    x : REAL;
+END_VAR
+VAR_OUTPUT
+    y : REAL;
+END_VAR
+FUZZIFY x
+    TERM lo := (0, 1) (4, 0);
+    TERM hi := (6, 0) (10, 1);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM low := 10;
+    TERM high := 100;
+    METHOD : COGS;
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    ACCU : MAX;
+    RULE 1 : IF x IS lo THEN y IS low;
+    RULE 2 : IF x IS hi THEN y IS high;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fcl_cogs_default_beyond_the_singletons_widens_the_range_it_derives():
+    """An output without RANGE gets its terms' extent, [10, 100] here, as jFuzzyLogic derives
+    it; `DEFAULT := 0` (returned where no rule fires) was then refused as outside "its range",
+    a range the file never wrote. COGS averages the singletons and samples no range, so the
+    range now holds the default, as it already did for linear (COGF) terms: 10 at x = 2, 0
+    where no rule fires, 100 at x = 9, the same numbers as with `RANGE := (0 .. 100)`."""
+    rb = parse_fcl(COGS_NO_RANGE, "s.fcl")
+    assert rb.variables["y"].universe == (0.0, 100.0)
+    assert any("`y` has no RANGE; its universe [0, 100] holds its terms' values and its "
+               "DEFAULT 0" in n for n in rb.notes)
+    written = parse_fcl(COGS_NO_RANGE.replace("    DEFAULT := 0;\n",
+                                              "    DEFAULT := 0;\n    RANGE := (0 .. 100);\n"),
+                        "r.fcl")
+    for x, want in [(2.0, 10.0), (5.0, 0.0), (9.0, 100.0), (3.0, 10.0)]:
+        assert outputs(rb, x=x)["y"] == want == outputs(written, x=x)["y"]
+
+
+def test_fcl_sampled_output_default_beyond_its_derived_range_says_the_range_was_derived():
+    """Under COG the derived range is sampled, so widening it would move the numbers from
+    jFuzzyLogic's; the refusal now says that the file gives no RANGE and which one to add."""
+    text = COGS_NO_RANGE.replace("TERM low := 10;", "TERM low := (10, 0) (20, 1) (30, 0);") \
+        .replace("TERM high := 100;", "TERM high := (70, 0) (80, 1) (100, 0);") \
+        .replace("METHOD : COGS;", "METHOD : COG;")
+    with pytest.raises(MitosError) as exc:
+        parse_fcl(text, "c.fcl")
+    assert exc.value.message.startswith("output `y` has no RANGE, and its DEFAULT 0 lies outside "
+                                        "[10, 100], the extent of its terms")
+    assert exc.value.hint.startswith("add `RANGE := (0 .. 100);`")
+    assert exc.value.span is not None and exc.value.span.line == 16
+
+
+SUGENO_CONSTANT_FIS = """\
+[System]
+Name='s'
+Type='sugeno'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='prod'
+OrMethod='probor'
+ImpMethod='prod'
+AggMethod='sum'
+DefuzzMethod='wtaver'
+
+[Input1]
+Name='t'
+Range=[24 34]
+NumMFs=2
+MF1='cool':'trimf',[14 24 34]
+MF2='warm':'trimf',[24 34 44]
+
+[Output1]
+Name='fan'
+Range=[0 1]
+NumMFs=2
+MF1='slow':'linear',[-0.01 0.5]
+MF2='full':'linear',[0 100]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+def test_a_constant_linear_term_beyond_the_range_converts_to_rules(tmp_path):
+    """A public Sugeno file writes `linear [0 0 100]` on `Range=[0 1]` (MATLAB's Sugeno ranges
+    bound nothing). The rule-language writer wrote it as the number 100, which a term set
+    refuses beyond the universe, and `convert --to rules` stopped with "a defect of `mitos
+    convert`; please report it". A constant linear term beyond the universe stays linear."""
+    src = tmp_path / "s.fis"
+    src.write_text(SUGENO_CONSTANT_FIS)
+    out = tmp_path / "s.rules"
+    result = runner.invoke(app, ["convert", str(src), "--to", "rules", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    terms = (tmp_path / "s.terms.yaml").read_text()
+    assert "full: {shape: linear, coefficients: {}, constant: 100}" in terms
+    X = np.linspace(24, 34, 41)
+    before = load_rulebase(src).evaluate(t=X)["fan"]
+    after = load_rulebase(out).evaluate(t=X)["fan"]
+    np.testing.assert_array_equal(after, before)
+    assert before[-1] == 100.0 and before[0] == pytest.approx(0.26, abs=1e-12)
+
+
+POINT_FIS = """\
+[System]
+Name='point'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules=2
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='centroid'
+
+[Input1]
+Name='tutor'
+Range=[0 1]
+NumMFs=2
+MF1='no':'trimf',[0 0 0]
+MF2='yes':'trimf',[1 1 1]
+
+[Output1]
+Name='grade'
+Range=[0 30]
+NumMFs=2
+MF1='low':'trimf',[0 0 7]
+MF2='high':'trimf',[23 30 30]
+
+[Rules]
+1, 1 (1) : 1
+2, 2 (1) : 1
+"""
+
+
+def test_convert_measures_at_the_universes_ends_where_a_term_is_one_point(tmp_path):
+    """A public file's 0/1 inputs have `trimf [0 0 0]` and `[1 1 1]` terms, 1 at one point,
+    which none of 2,000 draws meets: `convert --to fll` measured no difference and gave no
+    figure, while at tutor = 0 and 1 the written FLL's output moves (101 end points against
+    1000 midpoints). The ends and middles of the universes are measured too."""
+    src = tmp_path / "p.fis"
+    src.write_text(POINT_FIS)
+    result = runner.invoke(app, ["convert", str(src), "--to", "fll", "-o", str(tmp_path / "p.fll")])
+    assert result.exit_code == 0, result.output
+    moved = [line for line in result.stderr.splitlines() if "`grade` moves by up to" in line]
+    assert len(moved) == 1, result.stderr
+    assert moved[0].endswith("on 2,000 seeded inputs and 3 at the universes' ends and middles "
+                             "(largest at tutor=0)") or moved[0].endswith("(largest at tutor=1)")
+    before = load_rulebase(src).evaluate(tutor=np.array([0.0, 0.5, 1.0]))["grade"]
+    after = load_rulebase(tmp_path / "p.fll").evaluate(tutor=np.array([0.0, 0.5, 1.0]))["grade"]
+    assert before[1] == after[1] == 15.0 and before[0] != after[0]

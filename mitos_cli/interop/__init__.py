@@ -277,8 +277,9 @@ def sampled_at(rb: RuleBase, behavior: str | None = None) -> list[int]:
 def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
                           behavior: str | None = None, samples: int = 2000) -> list[str]:
     """How far the outputs of ``written`` (``rb`` written as ``fmt`` and read back) lie from
-    ``rb``'s, measured on ``samples`` seeded random inputs inside the universes: one note per
-    output that moves by more than 1e-9 of its range, with the largest difference and where."""
+    ``rb``'s, measured on ``samples`` seeded random inputs inside the universes and at the
+    universes' ends and middles: one note per output that moves by more than 1e-9 of its
+    range, with the largest difference and where."""
     import numpy as np
 
     from ..engine.compile import compile_rulebase
@@ -293,7 +294,14 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
                 f"base; its outputs were not compared"]
     rng = np.random.default_rng(np.random.SeedSequence(2024))
     lo, hi = np.array(before.universe, dtype=float).T
-    X = rng.uniform(lo, hi, size=(samples, len(before.inputs)))
+    k = len(before.inputs)
+    # and every input at its universe's ends and middle (all combinations up to 6 inputs): a
+    # term that is 1 at one point only (`trimf [0 0 0]` for a 0/1 input) no draw meets
+    levels = np.stack([lo, (lo + hi) / 2, hi], axis=1)
+    grid = (np.array(np.meshgrid(*levels, indexing="ij")).reshape(k, -1).T if 3 ** k <= 729
+            else levels.T.copy())
+    X = np.vstack([rng.uniform(lo, hi, size=(samples, k)), grid])
+    on = f"{samples:,} seeded inputs and {len(grid):,} at the universes' ends and middles"
     Y0 = evaluate(before, X, detail=False, strict=False).outputs
     cols = [before.inputs.index(name) for name in after.inputs]
     Y1 = evaluate(after, X[:, cols], detail=False, strict=False).outputs
@@ -310,8 +318,7 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
             row = int(np.argmax(one_sided))
             notes.append(f"reading the written {fmt.upper()} back, `{name}` is {b[row]:.6g} "
                          f"where the rule base gives {a[row]:.6g}, on "
-                         f"{int(one_sided.sum()):,} of {samples:,} seeded inputs "
-                         f"(first at {where(row)})")
+                         f"{int(one_sided.sum()):,} of {on} (first at {where(row)})")
         same = (np.isnan(a) & np.isnan(b)) | (a == b) | one_sided   # NaN = NaN, inf = inf
         with np.errstate(invalid="ignore"):                   # inf - inf, masked out
             diff = np.where(same, 0.0, np.abs(a - b))
@@ -326,8 +333,7 @@ def round_trip_difference(rb: RuleBase, written: RuleBase, fmt: str,
         share = (f" ({100 * diff[worst] / width:.2g}% of its range)" if np.isfinite(width)
                  and np.isfinite(diff[worst]) else "")
         notes.append(f"reading the written {fmt.upper()} back, `{name}` moves by up to "
-                     f"{diff[worst]:.3g}{share} on {samples:,} seeded inputs (largest at "
-                     f"{where(worst)})")
+                     f"{diff[worst]:.3g}{share} on {on} (largest at {where(worst)})")
     return notes
 
 

@@ -233,6 +233,8 @@ def _glued_error(glued: Glued, text: str, path: str | None) -> FormatError:
 
 def _expected(terminals: set[str]) -> str | None:
     words = sorted({_word(e) for e in terminals})
+    if len(words) == 1:
+        return words[0]                       # "a name", not "one of a name"
     return ("one of " + ", ".join(words)) if words else None
 
 
@@ -536,6 +538,7 @@ def _variable(node: Tree, role: Role, declared: Declared, settings: common.Recor
                           span=span_of(name_token))
     terms: list[Term] = []
     default = None
+    default_span: Span | None = None
     for item in node.children[1:]:
         kind = item.data
         if kind == "term":
@@ -557,13 +560,16 @@ def _variable(node: Tree, role: Role, declared: Declared, settings: common.Recor
             _option(item, settings, span_of, {}, notes)
         elif kind == "default_item":
             default = _default(item, span_of)   # nan: NaN when no rule fires, as asked
+            default_span = span_of(item)
             if ranges is not None:
-                ranges[name, "default"] = span_of(item)
+                ranges[name, "default"] = default_span
         elif kind == "lock_item":
             for word in item.children:
                 locks[name] = _lock_range(word, span_of)
+    weighted = any(entry[0] == "defuzzify" and entry[1] in ("weighted_average", "weighted_sum")
+                   for entry in settings)
     lo, hi = _universe(node, name, role, universe, terms, declared, default, span_of, notes,
-                       known)
+                       known, weighted, default_span)
     try:
         return Variable(name, role, (lo, hi), tuple(terms), "", "", default, span_of(name_token))
     except Exception as exc:                     # duplicate terms: TermSetError with a span
@@ -610,10 +616,14 @@ def _lock_range(word: Node, span_of: SpanOf) -> Span:
 
 def _universe(node: Tree, name: str, role: Role, universe: tuple[float, float] | None,
               terms: list[Term], declared: Declared, default: float | None, span_of: SpanOf,
-              notes: list[str], known: dict[str, Variable] | None) -> tuple[float, float]:
+              notes: list[str], known: dict[str, Variable] | None, weighted: bool = False,
+              default_span: Span | None = None) -> tuple[float, float]:
     """The variable's range: as declared or written (RANGE), else where jFuzzyLogic puts it,
     from its terms (:func:`_linear_extent` for linear output terms, :func:`_extent`); a
-    variable without terms or with an empty range is refused."""
+    variable without terms or with an empty range is refused. An output without RANGE whose
+    DEFAULT lies beyond its terms' extent: under COGS / COGSS (``weighted``), which average its
+    singletons and sample no range, the range is widened to hold the default, as for linear
+    terms; otherwise (a sampled output) it is refused, saying that the range was derived."""
     if not terms and (role == "output" or universe is None):
         raise FormatError(f"variable `{name}` has no terms", span=span_of(node),
                           hint=None if role == "output" else "an input without terms (it only "
@@ -622,8 +632,25 @@ def _universe(node: Tree, name: str, role: Role, universe: tuple[float, float] |
         names = [n for n, (r, _, _) in declared.items() if r == "input"]
         universe = _linear_extent(terms, names, known or {}, default, name, span_of(node),
                                   notes)
+    d = default if role == "output" and default is not None and default == default else None
+    if universe is None and d is not None and weighted and terms and \
+            all(t.shape == "singleton" for t in terms):
+        xs = [t.params[0] for t in terms]
+        if not min(xs) <= d <= max(xs):
+            universe = (min(*xs, d), max(*xs, d))
+            notes.append(f"{span_of(node)}: `{name}` has no RANGE; its universe [{universe[0]:g}, "
+                         f"{universe[1]:g}] holds its terms' values and its DEFAULT "
+                         f"{fmt_number(d)} (the weighted average samples no range)")
     if universe is None:
-        universe = _extent(terms, name, span_of(node), notes)
+        lo, hi = universe = _extent(terms, name, span_of(node), notes)
+        if d is not None and not lo <= d <= hi:
+            raise FormatError(
+                f"output `{name}` has no RANGE, and its DEFAULT {fmt_number(d)} lies outside "
+                f"[{lo:g}, {hi:g}], the extent of its terms, which jFuzzyLogic takes for its "
+                f"universe (`Variable.estimateUniverse`) and samples; a MITOS output's default "
+                f"lies inside its universe", span=default_span or span_of(node),
+                hint=f"add `RANGE := ({min(lo, d):g} .. {max(hi, d):g});` (the output is then "
+                     f"sampled there), or give a DEFAULT inside [{lo:g}, {hi:g}]")
     lo, hi = universe
     if not lo < hi:
         raise FormatError(f"variable `{name}`: range [{lo:g}, {hi:g}] is empty",

@@ -376,7 +376,7 @@ def _variable(span: Span, items: list[Item], role: Role, kind: str, n_inputs: in
                               hint=did_you_mean(key, VAR_KEYS))
     if "Name" not in values or "Range" not in values:
         raise FormatError("a variable needs `Name` and `Range`", span=span)
-    name = _string(*values["Name"])
+    name = _string(*values["Name"]).strip()   # `'User '` is `User`, as fuzzylite reads it
     terms = common.distinct_names(terms, name, notes, "rules refer to MFs by index, so "
                                   "nothing else changes")
     rng = _vector(*values["Range"])
@@ -411,7 +411,7 @@ def _mf(value: str, vspan: Span, role: str, kind: str, n_inputs: int) -> Term:
         raise FormatError(f"MF `{m.group(1)}`: `function` MFs (fuzzylite's formula of the "
                           f"engine's variables, `{m.group(3)[1:-1].strip()}`) are not supported",
                           span=vspan)
-    name, mf, params = m.group(1), m.group(2), _vector(m.group(3), vspan)
+    name, mf, params = m.group(1).strip(), m.group(2), _vector(m.group(3), vspan)
     if mf == "linear":
         if role != "output" or kind != "sugeno":
             raise FormatError(f"MF `{name}`: `linear` belongs to Sugeno outputs", span=vspan)

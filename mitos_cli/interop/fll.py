@@ -505,6 +505,8 @@ _RULE_WORDS = {"NAME": "a name", "NUMBER": "a number", "WORD": "a hedge", "LPAR"
 
 def _rule_words(terminals: Iterable[str] | None) -> str | None:
     words = sorted({_RULE_WORDS.get(str(t), str(t).lower()) for t in terminals or ()})
+    if len(words) == 1:
+        return words[0]                       # "a number", not "one of a number"
     return "one of " + ", ".join(words) if words else None
 
 

@@ -210,8 +210,9 @@ def _term_spec(rb: RuleBase, v: Variable, t: Term, inputs: list[str]) -> str:
         return f"{{shape: singleton, value: {_scalar(p[0])}{frozen}}}" if frozen else _scalar(p[0])
     if t.shape == "linear":
         coefficients = common.linear_coefficients(rb, v.name, t)
-        if not any(coefficients.values()):          # y = constant: the same as a number
-            return _scalar(p[-1])
+        lo, hi = _written_universe(rb, v)
+        if not any(coefficients.values()) and lo <= p[-1] <= hi:   # y = constant: a number
+            return _scalar(p[-1])            # (beyond the universe a number is refused there)
         given = ", ".join(f"{_scalar(n)}: {_scalar(a)}" for n, a in coefficients.items()
                           if a != 0.0)
         return f"{{shape: linear, coefficients: {{{given}}}, constant: {_scalar(p[-1])}}}"
