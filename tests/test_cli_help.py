@@ -291,3 +291,15 @@ def test_usage_of_convert_and_compare():
         cmd = every[name]
         ctx = cmd.make_context(f"mitos {name}", ["--help"], resilient_parsing=True)
         assert " ".join(cmd.collect_usage_pieces(ctx)) == expected
+
+
+def test_the_commands_that_answer_sigterm_and_sighup_list_their_codes():
+    """`simulate`, `compare` and `teach` stop on a SIGTERM or a SIGHUP as on Ctrl-C, exiting
+    143 or 129 (docs/reliability.md), and their help listed 130 alone."""
+    from mitos_cli.cli.help import exit_codes
+
+    for command in ("simulate", "compare", "teach"):
+        codes = dict(exit_codes(command))
+        assert {129, 130, 143} <= set(codes), command
+        assert "SIGTERM" in codes[143] and "SIGHUP" in codes[129]
+    assert 143 not in dict(exit_codes("eval"))

@@ -86,12 +86,19 @@ EXIT_CODES: tuple[tuple[int, str], ...] = (
     (1, "a mistake in a file or a value (the message says where and what)"),
     (2, "a usage error: an unknown option or value, a missing or bad argument"),
 )
+#: Stopped by a signal other than Ctrl-C, where a command answers it as Ctrl-C.
+STOPPED: tuple[tuple[int, str], ...] = (
+    (129, "SIGHUP (the terminal closed): as Ctrl-C"),
+    (143, "SIGTERM (kill, a scheduler's time limit): as Ctrl-C"),
+)
 OWN_EXIT_CODES: dict[str, tuple[tuple[int, str], ...]] = {
     "check": ((1, "a mistake in a file or value, or an error in the rule base"),),
     "simulate": ((3, "with --require success: a run did not succeed"),
-                 (130, "Ctrl-C: with --runs, the runs that finished are still reported")),
-    "compare": ((130, "Ctrl-C: the finished runs stay in DIR/results.csv (--resume)"),),
-    "teach": ((130, "Ctrl-C: the journal keeps every change (--resume)"),),
+                 (130, "Ctrl-C: with --runs, the runs that finished are still reported"),
+                 *STOPPED),
+    "compare": ((130, "Ctrl-C: the finished runs stay in DIR/results.csv (--resume)"),
+                *STOPPED),
+    "teach": ((130, "Ctrl-C: the journal keeps every change (--resume)"), *STOPPED),
 }
 
 
