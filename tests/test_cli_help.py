@@ -139,6 +139,22 @@ def test_every_option_that_takes_a_value_names_it_in_words():
     assert "<int range>" not in help_text and "<float range>" not in help_text
 
 
+def test_no_option_value_is_wider_than_its_help_column_leaves_it():
+    """`eval --fidelity [matlab|jfuzzylogic|fuzzylite|fuzzylite6|octave]` (48 characters)
+    was split mid-word by the help's table at 80 and 120 columns (`fuzzyl ite6`, `octav e`):
+    every option's value is a word short enough to stay whole, and where it names choices
+    the help lists them."""
+    wide = [f"{name} {p.opts[0]} {p.metavar}" for name, cmd in commands().items()
+            for p in cmd.params if p.param_type_name == "option"
+            and len(getattr(p, "metavar", None) or "") > 24]
+    assert wide == []
+    help_text = subprocess.run([sys.executable, "-m", "mitos_cli", "eval", "--help"],
+                               capture_output=True, text=True,
+                               env={**os.environ, "COLUMNS": "80"}).stdout
+    assert "ENGINE: matlab, jfuzzylogic, fuzzylite, fuzzylite6, octave" in " ".join(
+        line.strip("│ ") for line in help_text.splitlines())
+
+
 def test_every_choice_an_option_lists_is_said_in_its_help():
     """`eval --fidelity [matlab|jfuzzylogic|fuzzylite|fuzzylite6|octave]` said what four of
     its five engines do and nothing of `octave`: an option whose metavar lists its choices

@@ -223,8 +223,9 @@ def eval_command(
              "declared default, else an error; what happens without this option), nan, or "
              "skip the row. Given, it adds a `no_rule` column naming such outputs.")] = None,
     fidelity_name: Annotated[Optional[str], typer.Option(
-        "--fidelity", metavar=choices(Engine), autocompletion=completer(Engine),
-        help="Sample Mamdani outputs as this engine does, to reproduce its published tables: "
+        "--fidelity", metavar="ENGINE", autocompletion=completer(Engine),
+        help="Sample Mamdani outputs as this engine does (ENGINE: "
+             f"{', '.join(e.value for e in Engine)}), to reproduce its published tables: "
              "matlab (101 points with both ends), jfuzzylogic (1000 left cell ends, its COA, "
              "and inputs outside their ranges not clamped), "
              "fuzzylite (fuzzylite 8: cell midpoints at the file's resolution, 1000 where it "
