@@ -845,31 +845,38 @@ def test_a_save_over_the_original_killed_before_its_record_is_the_sessions_own(r
     assert rules.read_text() == original
 
 
+def _signal_once_a_save_is_written(monkeypatch, signum: int) -> None:
+    """Send this process ``signum`` once the next save has written its files, before the
+    session takes note of them (the second digest of the files: the first is before)."""
+    import os
+    import time
+
+    import mitos_cli.teach.session as session_module
+
+    real = session_module.files_digest
+    calls: list = []
+
+    def signalled(rb):
+        calls.append(rb)
+        if len(calls) == 2:
+            monkeypatch.setattr(session_module, "files_digest", real)
+            os.kill(os.getpid(), signum)
+            time.sleep(0.05)             # the signal is taken here
+        return real(rb)
+
+    monkeypatch.setattr(session_module, "files_digest", signalled)
+
+
 def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rules, monkeypatch,
                                                                              sigint):
     """A Ctrl-C after a save over the original wrote its files and before the session took
     note of them: the next save over them was refused, as if another program had changed
     them."""
-    import os
     import signal
-    import time
-
-    import mitos_cli.teach.session as session_module
 
     s = Session(rules, out=[].append)
     s.run("r27: if road is NARROW then speed is SLOW")
-    real = session_module.files_digest
-    calls: list = []
-
-    def interrupted(rb):
-        calls.append(rb)
-        if len(calls) == 2:              # after the files are written (the first: before)
-            monkeypatch.setattr(session_module, "files_digest", real)
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.05)             # the signal is taken here
-        return real(rb)
-
-    monkeypatch.setattr(session_module, "files_digest", interrupted)
+    _signal_once_a_save_is_written(monkeypatch, signal.SIGINT)
     with pytest.raises(KeyboardInterrupt):
         s.run(f"save {rules}")
     s.replay()                           # what the prompt does after a Ctrl-C
@@ -881,28 +888,14 @@ def test_ctrl_c_once_a_save_over_the_original_is_written_keeps_the_next_save(rul
 def test_a_sigterm_once_a_save_is_written_waits_until_it_is_journaled(rules, monkeypatch):
     """A SIGTERM (which `mitos teach` answers as Ctrl-C) once a save over the original wrote
     its files is raised after the session took note of them and journaled the save."""
-    import os
     import signal
-    import time
 
-    import mitos_cli.teach.session as session_module
     from mitos_cli.cli.progress import terminate_as_interrupt
     from mitos_cli.errors import Terminated
 
     s = Session(rules, out=[].append)
     s.run("r27: if road is NARROW then speed is SLOW")
-    real = session_module.files_digest
-    calls: list = []
-
-    def signalled(rb):
-        calls.append(rb)
-        if len(calls) == 2:              # after the files are written (the first: before)
-            monkeypatch.setattr(session_module, "files_digest", real)
-            os.kill(os.getpid(), signal.SIGTERM)
-            time.sleep(0.05)             # the signal is taken here
-        return real(rb)
-
-    monkeypatch.setattr(session_module, "files_digest", signalled)
+    _signal_once_a_save_is_written(monkeypatch, signal.SIGTERM)
     with terminate_as_interrupt(), pytest.raises(Terminated):
         s.run(f"save {rules}")
     assert s.journal.entries[-1]["op"] == "save" and not s.unsaved
