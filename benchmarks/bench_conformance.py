@@ -330,7 +330,10 @@ def round_trips(paths: list[Path], tmp: Path) -> dict:
                 counts[(fmt, "warned")] += 1
                 for note in notes:
                     m = re.search(r"moves by up to (\S+) \(([\d.e+-]+)% of its range\)", note)
-                    pct = float(m.group(2)) if m else float("inf")
+                    if m is None:       # a value where the other gives nan (no rule fires):
+                        counts[(fmt, "no rule")] += 1   # no percentage to rank
+                        continue
+                    pct = float(m.group(2))
                     if pct > largest.get(fmt, (-1.0, ""))[0]:
                         largest[fmt] = (pct, f"{path.name} [{behavior}]")
     return {"counts": counts, "largest": largest, "refusals": refusals}
@@ -453,6 +456,9 @@ def main(argv: list[str] | None = None) -> None:
         big = rt["largest"].get(fmt)
         extra = f"; largest warned difference {big[0]:.2g}% of the range ({big[1]})" if big \
             else ""
+        if c.get("no rule"):
+            extra += (f"; {c['no rule']} where no rule fires, a value on one side and nan on "
+                      "the other (MATLAB's middle of the range)")
         print(f"  to {fmt:5s}: {c.get('unchanged', 0)} unchanged, {c.get('warned', 0)} warned "
               f"with the measured difference, {c.get('refused by the writer', 0)} refused by "
               f"the writer{extra}")
