@@ -120,6 +120,7 @@ def test_a_stranger_cannot_reach_the_local_cluster(client):
     for worker in info["workers"].values():
         scratch = Path(worker["local_directory"]).parents[1]
         assert scratch.name.startswith("mitos-dask-") and scratch.stat().st_mode & 0o077 == 0
+        assert (scratch / "owner.pid").read_text() == f"{os.getpid()}\n"
     # the owner's client still works, and its results are the serial run's (tests above)
     assert client.submit(sum, [1, 2]).result() == 3
 
@@ -214,3 +215,39 @@ def test_a_study_stopped_early_closes_its_local_cluster_within_a_second():
     took = time.monotonic() - started
     assert len(workers) == 2
     assert took < 1.5 and not _alive(workers), f"{took:.2f} s"
+
+
+@pytest.mark.skipif(os.name == "nt", reason="not swept on Windows (os.kill(pid, 0) ends a process)")
+def test_scratch_left_by_a_process_that_is_gone_is_swept_and_nothing_else(tmp_path):
+    """A study killed with `kill -9` left its cluster's scratch directory in the temporary
+    directory for good (thirteen after the reliability campaign's kill harness): a local
+    cluster's start removes those whose owner process is gone, and only those."""
+    import subprocess
+    import sys
+
+    from mitos_cli.study.executors import swept_scratch
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+
+    def scratch(name: str, owner: str | None) -> Path:
+        path = tmp_path / name
+        (path / "dask-scratch-space" / "worker-1").mkdir(parents=True)
+        if owner is not None:
+            (path / "owner.pid").write_text(owner + "\n")
+        return path
+
+    dead = scratch("mitos-dask-dead", gone)
+    alive = scratch("mitos-dask-alive", str(os.getpid()))
+    old = scratch("mitos-dask-old", None)                 # made before owners were written
+    junk = scratch("mitos-dask-junk", "not a pid")
+    other = scratch("other-dead", gone)                   # not a cluster's
+    link = tmp_path / "mitos-dask-link"
+    link.symlink_to(dead.parent / "elsewhere", target_is_directory=True)
+    (dead.parent / "elsewhere").mkdir()
+    (dead.parent / "elsewhere" / "owner.pid").write_text(gone + "\n")
+
+    assert swept_scratch(str(tmp_path)) == [dead]
+    assert not dead.exists()
+    assert all(p.exists() for p in (alive, old, junk, other, link, dead.parent / "elsewhere"))
+    assert swept_scratch(str(tmp_path)) == []
