@@ -512,12 +512,17 @@ def test_a_child_forked_while_a_study_runs_does_not_hold_its_directory(tmp_path)
     running = ResultStore(tmp_path)
     running.start(study.manifest(), study.tasks(), resume=False)
     r, w = os.pipe()
+    ready_r, ready_w = os.pipe()
     pid = os.fork()
     if pid == 0:                        # the child: lives until the parent lets it end
         os.close(w)
+        os.write(ready_w, b"1")         # (fork returned here: its at-fork hooks have run)
         os.read(r, 1)
         os._exit(0)
     os.close(r)
+    os.close(ready_w)
+    assert os.read(ready_r, 1) == b"1"  # (a lock tried before the child's hooks ran failed)
+    os.close(ready_r)
     try:
         running.close()                 # the study's process lets go; its child lives on
         outcome = run_study(study, tmp_path, workers=1, resume=True, task_fn=fake_sim)
