@@ -593,14 +593,17 @@ def _remove_orphans(directory: Path) -> None:
         parts = p.name.rsplit(".", 3)
         if len(parts) != 4 or parts[3] != "tmp" or not parts[1].isdigit():
             continue
-        if str(p.resolve()) in named or _alive(int(parts[1])):
+        if str(p.resolve()) in named or process_alive(int(parts[1])):
             continue
         with contextlib.suppress(OSError):
             p.unlink()
 
 
-def _alive(pid: int) -> bool:
-    if pid == os.getpid():
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` may still run: what it left (a temporary file, a scratch
+    directory) is removed only when this says no. One of another user's counts as running;
+    on Windows every process does, since ``os.kill(pid, 0)`` there ends the process."""
+    if pid == os.getpid() or os.name == "nt":
         return True
     try:
         os.kill(pid, 0)

@@ -251,3 +251,14 @@ def test_scratch_left_by_a_process_that_is_gone_is_swept_and_nothing_else(tmp_pa
     assert not dead.exists()
     assert all(p.exists() for p in (alive, old, junk, other, link, dead.parent / "elsewhere"))
     assert swept_scratch(str(tmp_path)) == []
+
+
+def test_process_alive_never_signals_on_windows(monkeypatch):
+    """`os.kill(pid, 0)` asks whether a process runs on POSIX and ends it on Windows: what a
+    gone process left (a save's temporary file, a cluster's scratch) is kept there instead."""
+    import mitos_cli.fileio as fileio
+
+    asked: list = []
+    monkeypatch.setattr(fileio.os, "kill", lambda *a: asked.append(a))
+    monkeypatch.setattr(fileio.os, "name", "nt")
+    assert fileio.process_alive(2 ** 22 + 1) and asked == []

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import install_hint
+from ..fileio import process_alive
 from .spec import Task
 from .store import StudyError
 
@@ -233,22 +234,11 @@ def swept_scratch(tmp: str) -> list[Path]:
             pid = int((path / OWNER).read_text(encoding="ascii"))
         except (OSError, ValueError):
             continue
-        if pid <= 0 or _running(pid):
+        if pid <= 0 or process_alive(pid):
             continue
         shutil.rmtree(path, ignore_errors=True)
         swept.append(path)
     return swept
-
-
-def _running(pid: int) -> bool:
-    """Whether process ``pid`` exists (one of another user's counts: it is not gone)."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:
-        return True
-    return True
 
 
 @contextlib.contextmanager
